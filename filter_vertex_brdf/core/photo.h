@@ -1,0 +1,66 @@
+#pragma once
+// Photos: decoding to linear RGB and bilinear sampling with saturation detection.
+// 8-bit photos are sRGB-encoded (camera JPEG/PNG) and decoded with the sRGB EOTF; 16-bit PNG/TIFF
+// are taken as linear. Pixels are kept in their original 8/16-bit form (a 256/65536-entry table
+// decodes on sampling) so that hundreds of photos fit in memory.
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace vbrdf {
+
+enum class PhotoEncoding { Auto = 0, SRGB = 1, Linear = 2 };
+
+float srgb_to_linear(float encoded);  // IEC 61966-2-1 EOTF, input in [0,1]
+float linear_to_srgb(float linear);   // inverse, clamps to [0,1]
+
+struct Photo {
+  std::string path;
+  cv::Mat pixels;         // CV_8UC3 or CV_16UC3, RGB channel order, row 0 = top of the image
+  bool linear = false;    // true: codes are linear; false: sRGB-encoded
+  std::vector<float> lut; // code value -> linear intensity in [0,1]
+  int saturation_code = 255; // a channel at or above this code value is clipped
+  int width() const { return pixels.cols; }
+  int height() const { return pixels.rows; }
+};
+
+// Loads a photo. `saturation_level` in (0,1]: a channel >= level * max code counts as clipped.
+// Throws InputError naming the file when it is missing/unreadable, not 8/16-bit, or (when
+// expected_width/height > 0) its size differs from the raster's viewport.
+Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level = 0.99f,
+                 int expected_width = 0, int expected_height = 0);
+
+struct PixelSample {
+  float rgb[3] = {0, 0, 0};  // linear
+  bool inside = false;       // the bilinear footprint is inside the image
+  bool saturated = false;    // any channel of any of the 4 footprint pixels is clipped
+};
+
+// Bilinear sample at image-pixel coordinates (top-left origin, y down, centres at +0.5).
+PixelSample sample_bilinear(const Photo &photo, float x, float y);
+
+// Keeps decoded photos under a memory budget (least recently used are dropped and reloaded on
+// demand). Thread-safe.
+class PhotoCache {
+public:
+  PhotoCache(PhotoEncoding encoding, float saturation_level, size_t budget_bytes);
+  // Returns the photo of `path`, loading it if needed (validating its size when given).
+  std::shared_ptr<const Photo> get(const std::string &path, int expected_width = 0, int expected_height = 0);
+  size_t loads() const { return loads_; }  // number of decodes performed (for the report)
+
+private:
+  PhotoEncoding encoding_;
+  float saturation_level_;
+  size_t budget_;
+  size_t used_ = 0;
+  size_t loads_ = 0;
+  unsigned long tick_ = 0;
+  struct Entry { std::shared_ptr<const Photo> photo; size_t bytes; unsigned long last_use; };
+  std::vector<std::pair<std::string, Entry>> entries_;
+  std::mutex mutex_;
+};
+
+} // namespace vbrdf

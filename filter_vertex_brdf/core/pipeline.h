@@ -1,0 +1,79 @@
+#pragma once
+// The whole filter without MeshLab: project -> lights -> visibility -> samples -> diffuse colour
+// -> outputs. The plugin and the command-line tool both call this; they only differ in how they
+// obtain the mesh, the rasters and the GL context.
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "diffuse_color.h"
+#include "mesh_view.h"
+#include "output_ply.h"
+#include "samples.h"
+#include "visibility.h"
+
+namespace vbrdf {
+
+using LogFn = std::function<void(const std::string &line)>;
+
+enum class VisibilityChoice { Auto = 0, GL = 1, CPU = 2 };
+
+struct FitSettings {
+  GatherSettings gather;
+  VisibilitySettings visibility;
+  VisibilityChoice visibility_choice = VisibilityChoice::Auto;
+  std::string light_file;   // "" = search beside the project, then beside the images
+  std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
+};
+
+struct FitInput {
+  MeshView mesh;
+  std::string mesh_name;               // for messages
+  std::string mesh_path;               // the mesh file (never overwritten; may be empty)
+  std::vector<uint8_t> mesh_colors;    // RGBA8 per vertex (current colours, kept where unseen)
+  std::vector<Raster> rasters;
+  std::string project_path;            // the .mlp, used for default paths (may be empty)
+};
+
+// Per-raster world light directions from an .lp, matched by image file name.
+// Throws InputError naming the .lp and the raster when a raster has no entry, and naming
+// the entry when an .lp line matches no raster (a count or name mismatch).
+std::vector<std::array<float, 3>> resolve_light_directions(const std::vector<Raster> &rasters,
+                                                           const std::string &lp_path);
+
+// Checks everything that can be checked before any work: non-empty mesh with normals, at least
+// one raster, every raster with a valid shot and an existing photo of the shot's size.
+// Throws InputError with a message naming the item and the fix.
+void validate_input(const FitInput &input);
+
+struct FitResult {
+  std::vector<DiffuseEstimate> diffuse;   // per vertex
+  std::vector<uint8_t> colors_rgba;       // display colours: sRGB of rho where valid, else the input colour
+  std::vector<VertexAttribute> attributes;// what goes into the PLY
+  GatherStats gather;
+  std::string visibility_backend;         // name of the back end that ran
+  std::string light_file;                 // the .lp used
+  std::string output_ply;                 // where the PLY was written
+  std::string report;                     // human-readable report (also written beside the PLY)
+  size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0;
+  double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
+};
+
+// Creates the visibility back end: GL when `get_proc` is given and the context supports it
+// (unless CPU is forced), else CPU. Logs which one runs and why.
+std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh, const FitSettings &settings,
+                                                           const std::function<void *(const char *)> &get_proc,
+                                                           const LogFn &log);
+
+// Runs the pipeline and writes the PLY and the report (<ply>.report.txt). Nothing is written
+// if any stage fails. Throws InputError / ProcessingError.
+FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
+                  const ProgressFn &progress, const LogFn &log);
+
+// Default output path for a project: <folder>/<name>_brdf.ply ("vertex_brdf.ply" in the
+// current folder when no project path is known).
+std::string default_output_path(const std::string &project_path);
+
+} // namespace vbrdf

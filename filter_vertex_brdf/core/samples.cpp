@@ -1,0 +1,154 @@
+#include "samples.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "errors.h"
+
+namespace vbrdf {
+
+namespace {
+inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+inline void normalize3(float v[3]) {
+  const float len = std::sqrt(dot3(v, v));
+  if (len > 0)
+    for (int k = 0; k < 3; ++k) v[k] /= len;
+}
+
+void report(const ProgressFn &progress, float fraction, const char *stage) {
+  if (progress && !progress(std::min(std::max(fraction, 0.0f), 1.0f), stage))
+    throw ProcessingError("cancelled by the user");
+}
+
+void pack_bits(const std::vector<uint8_t> &flags, uint64_t *words) {
+  for (size_t v = 0; v < flags.size(); ++v)
+    if (flags[v]) words[v / 64] |= uint64_t(1) << (v % 64);
+}
+
+int bit_index(uint16_t flag) {
+  int i = 0;
+  while (flag > 1) flag >>= 1, ++i;
+  return i;
+}
+} // namespace
+
+VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                   const std::vector<std::array<float, 3>> &light_dirs_world,
+                                   VisibilityBackend &backend, const ProgressFn &progress) {
+  VisibilityMasks masks;
+  masks.vertex_count = mesh.vertex_count;
+  masks.raster_count = rasters.size();
+  masks.unoccluded.assign(masks.words() * rasters.size(), 0);
+  masks.unshadowed.assign(masks.words() * rasters.size(), 0);
+  std::vector<uint8_t> buffer(mesh.vertex_count);
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    report(progress, float(r) / float(rasters.size()), "visibility");
+    std::fill(buffer.begin(), buffer.end(), 0);
+    backend.camera_pass(rasters[r].shot, buffer.data());
+    pack_bits(buffer, &masks.unoccluded[r * masks.words()]);
+    std::fill(buffer.begin(), buffer.end(), 0);
+    backend.light_pass(light_dirs_world[r].data(), buffer.data());
+    pack_bits(buffer, &masks.unshadowed[r * masks.words()]);
+  }
+  report(progress, 1.0f, "visibility");
+  return masks;
+}
+
+uint16_t make_sample(const float position[3], const float normal_in[3], const Raster &raster, uint16_t raster_index,
+                     const float light_dir[3], const Photo &photo, bool camera_clear, bool light_clear,
+                     const GatherSettings &settings, Sample &out) {
+  out = Sample{{0, 0, 0}, 0, 0, raster_index, 0};
+  float n[3] = {normal_in[0], normal_in[1], normal_in[2]};
+  normalize3(n);
+  float centre[3];
+  camera_centre(raster.shot, centre);
+  float e[3] = {centre[0] - position[0], centre[1] - position[1], centre[2] - position[2]};
+  normalize3(e);
+
+  uint16_t flags = 0;
+  const ImagePoint ip = project_to_image(raster.shot, position);
+  if (!ip.in_front || !(ip.x >= 0 && ip.y >= 0 && ip.x < float(raster.width()) && ip.y < float(raster.height())))
+    flags |= kOffImage;
+  if (dot3(n, e) <= 0) flags |= kBackFacing;
+  if (!camera_clear) flags |= kOccluded;
+
+  const float d = dot3(n, light_dir);
+  const float r[3] = {2 * d * n[0] - light_dir[0], 2 * d * n[1] - light_dir[1], 2 * d * n[2] - light_dir[2]};
+  const float s = dot3(r, e);
+  out.n_dot_l = d;
+  out.r_dot_e = s;
+  if (d <= 0) flags |= kAttachedShadow;
+  if (!light_clear) flags |= kCastShadow;
+  if (d > 0 && d < settings.diffuse_threshold) flags |= kGrazing;
+  if (d > 0 && s > settings.specular_threshold) flags |= kHighlight;
+
+  if (!(flags & kNotSeen)) {
+    const PixelSample px = sample_bilinear(photo, ip.x, ip.y);
+    if (!px.inside) flags |= kOffImage;  // bilinear footprint crosses the image border
+    if (px.saturated) flags |= kSaturated;
+    for (int c = 0; c < 3; ++c) out.rgb[c] = px.rgb[c];
+  }
+  out.flags = flags;
+  return flags;
+}
+
+GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
+                           const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
+                           const GatherSettings &settings, PhotoCache &photos,
+                           const std::function<void(const SampleChunk &)> &consume, const ProgressFn &progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (rasters.size() > 65535) throw InputError("More than 65535 photos in one project are not supported.");
+  GatherStats stats;
+  stats.raster_seen_vertices.assign(rasters.size(), 0);
+  const size_t raster_count = std::max<size_t>(rasters.size(), 1);
+  // A chunk holds a dense vertices x rasters block before compaction: size it to the budget.
+  const size_t chunk_vertices = std::max<size_t>(
+      1024, settings.chunk_sample_bytes / (sizeof(Sample) * raster_count));
+  std::vector<Sample> dense;
+  SampleChunk chunk;
+
+  for (size_t first = 0; first < mesh.vertex_count; first += chunk_vertices) {
+    const size_t count = std::min(chunk_vertices, mesh.vertex_count - first);
+    dense.resize(count * rasters.size());
+    for (size_t r = 0; r < rasters.size(); ++r) {
+      report(progress, (float(first) + float(count) * float(r) / float(raster_count)) / float(mesh.vertex_count),
+             "gathering samples");
+      const Raster &raster = rasters[r];
+      const auto photo = photos.get(raster.image_path, raster.width(), raster.height());
+      const float *light = light_dirs_world[r].data();
+#pragma omp parallel for schedule(dynamic, 1024)
+      for (long long i = 0; i < (long long)count; ++i) {
+        const size_t v = first + size_t(i);
+        make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo,
+                    masks.camera_clear(r, v), masks.light_clear(r, v), settings, dense[size_t(i) * rasters.size() + r]);
+      }
+    }
+    // Compact: keep samples seen by the camera, in vertex order.
+    chunk.first_vertex = uint32_t(first);
+    chunk.vertex_count = uint32_t(count);
+    chunk.offsets.assign(count + 1, 0);
+    chunk.samples.clear();
+    for (size_t i = 0; i < count; ++i) {
+      for (size_t r = 0; r < rasters.size(); ++r) {
+        const Sample &s = dense[i * rasters.size() + r];
+        ++stats.pairs;
+        for (uint16_t f = s.flags; f; f &= uint16_t(f - 1)) ++stats.flag_counts[bit_index(uint16_t(f & -f))];
+        if (s.flags & kNotSeen) continue;
+        chunk.samples.push_back(s);
+        ++stats.raster_seen_vertices[r];
+      }
+      chunk.offsets[i + 1] = uint32_t(chunk.samples.size());
+    }
+    stats.stored += chunk.samples.size();
+    ++stats.chunks;
+    consume(chunk);
+  }
+  report(progress, 1.0f, "gathering samples");
+  stats.photo_loads = photos.loads();
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+} // namespace vbrdf

@@ -1,0 +1,113 @@
+#pragma once
+// Samples: one per (vertex, photo) pair in which the vertex is seen by the photo's camera.
+// Everything later stages read (colour, fit, coverage) comes from here.
+//
+// Memory: visibility is computed per photo for all vertices and kept as bit masks
+// (2 bits per vertex and photo); pixel samples are then produced per vertex chunk, so the number
+// of photos and vertices is limited by disk and time, not by memory. A sample is 24 bytes.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "camera.h"
+#include "mesh_view.h"
+#include "photo.h"
+#include "visibility.h"
+
+namespace vbrdf {
+
+enum SampleFlag : uint16_t {
+  kOffImage = 1u << 0,        // projects outside the photo or behind the camera (never stored)
+  kBackFacing = 1u << 1,      // N.E <= 0 (never stored)
+  kOccluded = 1u << 2,        // hidden by other geometry from the camera (never stored)
+  kAttachedShadow = 1u << 3,  // N.L <= 0: faces away from the light
+  kCastShadow = 1u << 4,      // other geometry between the vertex and the light
+  kSaturated = 1u << 5,       // a channel is clipped in the bilinear footprint
+  kGrazing = 1u << 6,         // 0 < N.L < T_d
+  kHighlight = 1u << 7,       // R.E > T_s (specular sample)
+};
+constexpr uint16_t kNotSeen = kOffImage | kBackFacing | kOccluded;
+constexpr uint16_t kShadowed = kAttachedShadow | kCastShadow;
+
+struct Sample {
+  float rgb[3];      // linear pixel colour (bilinear)
+  float n_dot_l;     // d = N.L
+  float r_dot_e;     // s = R.E, R = 2(N.L)N - L, E = unit vector from the vertex to the camera centre
+  uint16_t raster;   // index of the photo
+  uint16_t flags;    // SampleFlag bits
+};
+static_assert(sizeof(Sample) == 24, "Sample must stay compact");
+
+// Usable for the diffuse colour: lit, not grazing, not a highlight, not saturated.
+inline bool is_diffuse_sample(const Sample &s) {
+  return (s.flags & (kShadowed | kSaturated | kGrazing | kHighlight)) == 0;
+}
+// Usable as specular evidence: lit, unsaturated highlight.
+inline bool is_specular_sample(const Sample &s) {
+  return (s.flags & (kShadowed | kSaturated)) == 0 && (s.flags & kHighlight) != 0;
+}
+
+struct GatherSettings {
+  float specular_threshold = 0.9f;   // T_s on R.E
+  float diffuse_threshold = 0.5f;    // T_d on N.L
+  PhotoEncoding encoding = PhotoEncoding::Auto;
+  float saturation_level = 0.99f;    // fraction of the maximum code value counted as clipped
+  size_t photo_cache_bytes = size_t(2) << 30;  // decoded photos kept in memory
+  size_t chunk_sample_bytes = size_t(256) << 20; // target size of one chunk's samples
+};
+
+// Per-photo, per-vertex occlusion bits from the depth passes.
+struct VisibilityMasks {
+  size_t vertex_count = 0;
+  size_t raster_count = 0;
+  std::vector<uint64_t> unoccluded;  // raster-major: bit (r * words + v/64)
+  std::vector<uint64_t> unshadowed;
+  size_t words() const { return (vertex_count + 63) / 64; }
+  bool camera_clear(size_t r, size_t v) const { return (unoccluded[r * words() + v / 64] >> (v % 64)) & 1u; }
+  bool light_clear(size_t r, size_t v) const { return (unshadowed[r * words() + v / 64] >> (v % 64)) & 1u; }
+};
+
+// Progress: fraction in [0,1] and a short label. Returns false to cancel (core then throws
+// ProcessingError("cancelled")).
+using ProgressFn = std::function<bool(float fraction, const char *stage)>;
+
+// Runs the camera and light depth passes for every raster. light_dirs_world[r] is the unit
+// direction towards the light of raster r.
+VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                   const std::vector<std::array<float, 3>> &light_dirs_world,
+                                   VisibilityBackend &backend, const ProgressFn &progress = {});
+
+// Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`.
+// `camera_clear`/`light_clear` come from the depth passes. Returns the flags; when the result
+// has any kNotSeen flag, `out` holds only flags and geometry terms.
+uint16_t make_sample(const float position[3], const float normal[3], const Raster &raster, uint16_t raster_index,
+                     const float light_dir_world[3], const Photo &photo, bool camera_clear, bool light_clear,
+                     const GatherSettings &settings, Sample &out);
+
+struct SampleChunk {
+  uint32_t first_vertex = 0;
+  uint32_t vertex_count = 0;
+  std::vector<uint32_t> offsets;  // vertex_count + 1 entries: samples of vertex first_vertex + i
+  std::vector<Sample> samples;    //   are samples[offsets[i] .. offsets[i+1])
+};
+
+struct GatherStats {
+  uint64_t pairs = 0;             // vertex x raster pairs examined
+  uint64_t stored = 0;            // samples stored (seen by the camera)
+  uint64_t flag_counts[16] = {};  // pairs with each SampleFlag bit set (index = bit position)
+  std::vector<uint32_t> raster_seen_vertices;  // per raster: vertices it sees
+  size_t chunks = 0;
+  size_t photo_loads = 0;
+  double seconds = 0;
+};
+
+// Streams samples chunk by chunk (vertex ranges sized by settings.chunk_sample_bytes) to
+// `consume`. Chunks arrive in vertex order; the chunk object is reused after `consume` returns.
+GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
+                           const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
+                           const GatherSettings &settings, PhotoCache &photos,
+                           const std::function<void(const SampleChunk &)> &consume, const ProgressFn &progress = {});
+
+} // namespace vbrdf

@@ -1,0 +1,120 @@
+// Sample flags and geometry terms for constructed vertex/camera/light configurations.
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "samples.h"
+#include "test_paths.h"
+#include "test_scenes.h"
+
+using namespace vbrdf;
+
+namespace {
+struct Fixture {
+  Raster raster;
+  Photo photo;
+  GatherSettings settings;
+  Fixture() {
+    const float c[3] = {0, 0, 10}, t[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+    raster.shot = test::make_look_at_shot(c, t, up, 500, 64, 48);
+    raster.label = "r0";
+    cv::Mat img(48, 64, CV_8UC3, cv::Scalar(100, 150, 200));
+    img.at<cv::Vec3b>(10, 10) = cv::Vec3b(255, 255, 255);
+    raster.image_path = test::scratch_dir("samples") + "/img.png";
+    cv::imwrite(raster.image_path, img);
+    photo = load_photo(raster.image_path, PhotoEncoding::Auto);
+  }
+  Sample sample(const float p[3], const float n[3], const float l[3], bool cam = true, bool light = true) {
+    Sample s;
+    make_sample(p, n, raster, 3, l, photo, cam, light, settings, s);
+    return s;
+  }
+};
+const float kOrigin[3] = {0, 0, 0};
+const float kFacing[3] = {0, 0, 1};
+} // namespace
+
+TEST(Samples, HeadOnLightIsHighlightAndColourIsDecoded) {
+  Fixture f;
+  const Sample s = f.sample(kOrigin, kFacing, kFacing);
+  EXPECT_EQ(s.raster, 3);
+  EXPECT_NEAR(s.n_dot_l, 1, 1e-6);
+  EXPECT_NEAR(s.r_dot_e, 1, 1e-6);
+  EXPECT_EQ(s.flags, kHighlight);
+  EXPECT_NEAR(s.rgb[0], srgb_to_linear(200 / 255.0f), 1e-5);  // BGR on disk
+  EXPECT_TRUE(is_specular_sample(s));
+  EXPECT_FALSE(is_diffuse_sample(s));
+}
+
+TEST(Samples, DiffuseGrazingAndShadowFlags) {
+  Fixture f;
+  const float side60[3] = {0.8660254f, 0, 0.5f};  // N.L = 0.5 exactly at the threshold: not grazing
+  Sample s = f.sample(kOrigin, kFacing, side60);
+  EXPECT_EQ(s.flags, 0) << s.flags;
+  EXPECT_NEAR(s.n_dot_l, 0.5, 1e-6);
+  EXPECT_NEAR(s.r_dot_e, 0.5, 1e-2);  // R = (-0.866, 0, 0.5), E ~ (0, 0, 1)
+  EXPECT_TRUE(is_diffuse_sample(s));
+  const float graze[3] = {0.97f, 0, 0.2431f};
+  EXPECT_EQ(f.sample(kOrigin, kFacing, graze).flags, kGrazing);
+  const float behind[3] = {0, 0, -1};
+  EXPECT_EQ(f.sample(kOrigin, kFacing, behind).flags, kAttachedShadow);
+  EXPECT_EQ(f.sample(kOrigin, kFacing, side60, true, false).flags, kCastShadow);
+}
+
+TEST(Samples, NotSeenCases) {
+  Fixture f;
+  const float away[3] = {0, 0, -1};
+  EXPECT_TRUE(f.sample(kOrigin, away, kFacing).flags & kBackFacing);
+  EXPECT_TRUE(f.sample(kOrigin, kFacing, kFacing, false).flags & kOccluded);
+  const float far_right[3] = {5, 0, 0};
+  EXPECT_TRUE(f.sample(far_right, kFacing, kFacing).flags & kOffImage);
+  const float behind_cam[3] = {0, 0, 20};
+  EXPECT_TRUE(f.sample(behind_cam, kFacing, kFacing).flags & kOffImage);
+}
+
+TEST(Samples, SaturatedPixelIsFlagged) {
+  Fixture f;
+  // Image pixel (10,10) is white. Find the world point projecting onto its centre: x = (10.5-32)/500*10.
+  const float p[3] = {(10.5f - 32) / 50.0f, (24 - 10.5f) / 50.0f, 0};
+  const float side60[3] = {0.8660254f, 0, 0.5f};
+  const Sample s = f.sample(p, kFacing, side60);
+  EXPECT_TRUE(s.flags & kSaturated);
+  EXPECT_FALSE(is_diffuse_sample(s));
+}
+
+TEST(Samples, GatherStreamsChunksInVertexOrder) {
+  // 3000 vertices on a plane facing the camera, 2 photos, forcing ~3 chunks.
+  Fixture f;
+  MeshData mesh;
+  for (int i = 0; i < 3000; ++i) {
+    mesh.positions.insert(mesh.positions.end(), {-0.5f + (i % 60) / 60.0f, -0.4f + (i / 60) / 70.0f, 0});
+    mesh.normals.insert(mesh.normals.end(), {0, 0, 1});
+  }
+  mesh.indices = {0, 1, 60};
+  std::vector<Raster> rasters = {f.raster, f.raster};
+  std::vector<std::array<float, 3>> lights = {{{0, 0, 1}}, {{0.8660254f, 0, 0.5f}}};
+  VisibilityMasks masks;
+  masks.vertex_count = 3000;
+  masks.raster_count = 2;
+  masks.unoccluded.assign(masks.words() * 2, ~uint64_t(0));
+  masks.unshadowed.assign(masks.words() * 2, ~uint64_t(0));
+  masks.unshadowed[masks.words() + 0] = 0;  // raster 1: vertices 0..63 in cast shadow
+  GatherSettings settings;
+  settings.chunk_sample_bytes = 1024 * sizeof(Sample) * 2;
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
+  uint32_t next = 0;
+  size_t total = 0;
+  const GatherStats stats = gather_samples(mesh.view(), rasters, lights, masks, settings, cache, [&](const SampleChunk &c) {
+    EXPECT_EQ(c.first_vertex, next);
+    next += c.vertex_count;
+    total += c.samples.size();
+    for (uint32_t i = 0; i < c.vertex_count; ++i)
+      for (uint32_t k = c.offsets[i]; k < c.offsets[i + 1]; ++k)
+        if (c.first_vertex + i < 64 && c.samples[k].raster == 1) EXPECT_TRUE(c.samples[k].flags & kCastShadow);
+  });
+  EXPECT_EQ(next, 3000u);
+  EXPECT_EQ(stats.chunks, 3u);
+  EXPECT_EQ(stats.pairs, 6000u);
+  EXPECT_EQ(stats.stored, total);
+  EXPECT_EQ(stats.flag_counts[4], 64u);  // kCastShadow is bit 4
+  EXPECT_EQ(cache.loads(), 1u);          // same photo file: decoded once
+}
