@@ -1,0 +1,42 @@
+#pragma once
+// Synthetic per-vertex samples from known Phong parameters (for fit tests and benchmarks).
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "phong_fit.h"
+
+namespace vbrdf {
+namespace test {
+
+struct TruePhong {
+  float rho[3];  // k_d * C
+  float ks, alpha;
+};
+
+// n samples: a third (at least `n_highlight` if given >= 0) near the specular peak
+// (s in [1 - 4/alpha, 1]), the rest spread over d in [0.1, 1], s in [-1, 0.9]; relative
+// Gaussian noise `noise` on every channel. Flags set as the gatherer would (T_s = 0.9).
+inline std::vector<Sample> synth_samples(const TruePhong &t, int n, float noise, std::mt19937 &rng,
+                                         int n_highlight = -1) {
+  std::uniform_real_distribution<float> u(0, 1);
+  std::normal_distribution<float> gauss(0, 1);
+  const int nh = n_highlight >= 0 ? std::min(n, n_highlight) : n / 3;
+  std::vector<Sample> out;
+  for (int i = 0; i < n; ++i) {
+    Sample s{};
+    s.n_dot_l = 0.1f + 0.9f * u(rng);
+    s.r_dot_e = i < nh ? 1.0f - std::min(0.099f, 4.0f / t.alpha) * u(rng) : -1.0f + 1.9f * u(rng);
+    const float g = s.r_dot_e > 0 ? std::pow(s.r_dot_e, t.alpha) : 0.0f;
+    for (int c = 0; c < 3; ++c) {
+      const float clean = t.rho[c] * s.n_dot_l + t.ks * g;
+      s.rgb[c] = std::max(0.0f, clean * (1 + noise * gauss(rng)));
+    }
+    s.flags = (s.r_dot_e > 0.9f ? kHighlight : 0) | (s.n_dot_l < 0.5f ? kGrazing : 0);
+    out.push_back(s);
+  }
+  return out;
+}
+
+} // namespace test
+} // namespace vbrdf
