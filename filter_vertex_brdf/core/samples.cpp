@@ -34,23 +34,79 @@ int bit_index(uint16_t flag) {
 }
 } // namespace
 
+bool VisibilityMasks::sees_any(size_t r, size_t first, size_t count) const {
+  if (count == 0) return false;
+  const uint64_t *w = &seen[r * words()];
+  const size_t last = first + count - 1;
+  for (size_t i = first / 64; i <= last / 64; ++i) {
+    uint64_t bits = w[i];
+    if (i == first / 64) bits &= ~uint64_t(0) << (first % 64);
+    if (i == last / 64 && last % 64 != 63) bits &= (uint64_t(1) << (last % 64 + 1)) - 1;
+    if (bits) return true;
+  }
+  return false;
+}
+
+namespace {
+// Combines the camera pass with the per-vertex frustum and facing tests into `seen`, counting why
+// vertices are not seen (off image first, then back-facing, then occluded).
+void classify_seen(const MeshView &mesh, const Raster &raster, const std::vector<uint8_t> &clear, uint64_t *seen_words,
+                   uint32_t counts[4]) {
+  float centre[3];
+  camera_centre(raster.shot, centre);
+  uint64_t off = 0, back = 0, occ = 0, seen = 0;
+  const long long words = (long long)((mesh.vertex_count + 63) / 64);
+#pragma omp parallel for reduction(+ : off, back, occ, seen) schedule(static)
+  for (long long w = 0; w < words; ++w) {
+    uint64_t bits = 0;
+    const size_t end = std::min(mesh.vertex_count, size_t(w + 1) * 64);
+    for (size_t v = size_t(w) * 64; v < end; ++v) {
+      const float *p = mesh.positions + 3 * v, *n = mesh.normals + 3 * v;
+      const ImagePoint ip = project_to_image(raster.shot, p);
+      if (!ip.in_front || !(ip.x >= 0 && ip.y >= 0 && ip.x < float(raster.width()) && ip.y < float(raster.height()))) {
+        ++off;
+        continue;
+      }
+      const float e[3] = {centre[0] - p[0], centre[1] - p[1], centre[2] - p[2]};
+      if (dot3(n, e) <= 0) {
+        ++back;
+        continue;
+      }
+      if (!clear[v]) {
+        ++occ;
+        continue;
+      }
+      bits |= uint64_t(1) << (v % 64);
+      ++seen;
+    }
+    seen_words[w] = bits;
+  }
+  counts[0] = uint32_t(off), counts[1] = uint32_t(back), counts[2] = uint32_t(occ), counts[3] = uint32_t(seen);
+}
+} // namespace
+
 VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
                                    const std::vector<std::array<float, 3>> &light_dirs_world,
                                    VisibilityBackend &backend, const ProgressFn &progress) {
   VisibilityMasks masks;
   masks.vertex_count = mesh.vertex_count;
   masks.raster_count = rasters.size();
-  masks.unoccluded.assign(masks.words() * rasters.size(), 0);
-  masks.unshadowed.assign(masks.words() * rasters.size(), 0);
+  masks.seen.assign(masks.words() * rasters.size(), 0);
+  masks.lit.assign(masks.words() * rasters.size(), 0);
+  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded, &masks.seen_count}) v->assign(rasters.size(), 0);
   std::vector<uint8_t> buffer(mesh.vertex_count);
   for (size_t r = 0; r < rasters.size(); ++r) {
     report(progress, float(r) / float(rasters.size()), "visibility");
     std::fill(buffer.begin(), buffer.end(), 0);
     backend.camera_pass(rasters[r].shot, buffer.data());
-    pack_bits(buffer, &masks.unoccluded[r * masks.words()]);
+    uint32_t counts[4];
+    classify_seen(mesh, rasters[r], buffer, &masks.seen[r * masks.words()], counts);
+    masks.off_image[r] = counts[0], masks.back_facing[r] = counts[1], masks.occluded[r] = counts[2];
+    masks.seen_count[r] = counts[3];
+    if (counts[3] == 0) continue;  // a photo that sees nothing needs no shadow pass
     std::fill(buffer.begin(), buffer.end(), 0);
     backend.light_pass(light_dirs_world[r].data(), buffer.data());
-    pack_bits(buffer, &masks.unshadowed[r * masks.words()]);
+    pack_bits(buffer, &masks.lit[r * masks.words()]);
   }
   report(progress, 1.0f, "visibility");
   return masks;
@@ -116,13 +172,23 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
       report(progress, (float(first) + float(count) * float(r) / float(raster_count)) / float(mesh.vertex_count),
              "gathering samples");
       const Raster &raster = rasters[r];
+      if (!masks.sees_any(r, first, count)) {  // skip: do not even load the photo
+        ++stats.rasters_skipped;
+        for (size_t i = 0; i < count; ++i) dense[i * rasters.size() + r].flags = kOccluded;
+        continue;
+      }
       const auto photo = photos.get(raster.image_path, raster.width(), raster.height());
       const float *light = light_dirs_world[r].data();
 #pragma omp parallel for schedule(dynamic, 1024)
       for (long long i = 0; i < (long long)count; ++i) {
         const size_t v = first + size_t(i);
-        make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo,
-                    masks.camera_clear(r, v), masks.light_clear(r, v), settings, dense[size_t(i) * rasters.size() + r]);
+        Sample &out = dense[size_t(i) * rasters.size() + r];
+        if (!masks.is_seen(r, v)) {
+          out.flags = kOccluded;  // not seen: never stored (why is counted by the visibility pass)
+          continue;
+        }
+        make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo, true,
+                    masks.is_lit(r, v), settings, out);
       }
     }
     // Compact: keep samples seen by the camera, in vertex order.
@@ -133,9 +199,8 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     for (size_t i = 0; i < count; ++i) {
       for (size_t r = 0; r < rasters.size(); ++r) {
         const Sample &s = dense[i * rasters.size() + r];
-        ++stats.pairs;
-        for (uint16_t f = s.flags; f; f &= uint16_t(f - 1)) ++stats.flag_counts[bit_index(uint16_t(f & -f))];
         if (s.flags & kNotSeen) continue;
+        for (uint16_t f = s.flags; f; f &= uint16_t(f - 1)) ++stats.flag_counts[bit_index(uint16_t(f & -f))];
         chunk.samples.push_back(s);
         ++stats.raster_seen_vertices[r];
       }
@@ -146,6 +211,12 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     consume(chunk);
   }
   report(progress, 1.0f, "gathering samples");
+  stats.pairs = uint64_t(mesh.vertex_count) * rasters.size();
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    stats.flag_counts[bit_index(kOffImage)] += masks.off_image[r];
+    stats.flag_counts[bit_index(kBackFacing)] += masks.back_facing[r];
+    stats.flag_counts[bit_index(kOccluded)] += masks.occluded[r];
+  }
   stats.photo_loads = photos.loads();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;

@@ -58,15 +58,20 @@ struct GatherSettings {
   size_t chunk_sample_bytes = size_t(256) << 20; // target size of one chunk's samples
 };
 
-// Per-photo, per-vertex occlusion bits from the depth passes.
+// Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
+// not occluded (the camera pass combined with the per-vertex frustum/facing test), `lit` = not in
+// cast shadow. Per-photo counts say why vertices were not seen.
 struct VisibilityMasks {
   size_t vertex_count = 0;
   size_t raster_count = 0;
-  std::vector<uint64_t> unoccluded;  // raster-major: bit (r * words + v/64)
-  std::vector<uint64_t> unshadowed;
+  std::vector<uint64_t> seen;  // raster-major: word (r * words() + v / 64), bit v % 64
+  std::vector<uint64_t> lit;
+  std::vector<uint32_t> off_image, back_facing, occluded, seen_count;  // per raster
   size_t words() const { return (vertex_count + 63) / 64; }
-  bool camera_clear(size_t r, size_t v) const { return (unoccluded[r * words() + v / 64] >> (v % 64)) & 1u; }
-  bool light_clear(size_t r, size_t v) const { return (unshadowed[r * words() + v / 64] >> (v % 64)) & 1u; }
+  bool is_seen(size_t r, size_t v) const { return (seen[r * words() + v / 64] >> (v % 64)) & 1u; }
+  bool is_lit(size_t r, size_t v) const { return (lit[r * words() + v / 64] >> (v % 64)) & 1u; }
+  // True when raster r sees at least one vertex in [first, first + count).
+  bool sees_any(size_t r, size_t first, size_t count) const;
 };
 
 // Progress: fraction in [0,1] and a short label. Returns false to cancel (core then throws
@@ -80,7 +85,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
                                    VisibilityBackend &backend, const ProgressFn &progress = {});
 
 // Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`.
-// `camera_clear`/`light_clear` come from the depth passes. Returns the flags; when the result
+// `camera_clear`/`light_clear` come from the depth passes (occlusion / cast shadow). Returns the flags; when the result
 // has any kNotSeen flag, `out` holds only flags and geometry terms.
 uint16_t make_sample(const float position[3], const float normal[3], const Raster &raster, uint16_t raster_index,
                      const float light_dir_world[3], const Photo &photo, bool camera_clear, bool light_clear,
@@ -99,12 +104,15 @@ struct GatherStats {
   uint64_t flag_counts[16] = {};  // pairs with each SampleFlag bit set (index = bit position)
   std::vector<uint32_t> raster_seen_vertices;  // per raster: vertices it sees
   size_t chunks = 0;
+  size_t rasters_skipped = 0;     // raster x chunk pairs skipped because the raster sees no vertex there
   size_t photo_loads = 0;
   double seconds = 0;
 };
 
 // Streams samples chunk by chunk (vertex ranges sized by settings.chunk_sample_bytes) to
 // `consume`. Chunks arrive in vertex order; the chunk object is reused after `consume` returns.
+// Only pairs the masks mark as seen are sampled; a photo that sees no vertex of a chunk is not
+// even loaded (GatherStats::rasters_skipped counts such raster x chunk pairs).
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
                            const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
                            const GatherSettings &settings, PhotoCache &photos,

@@ -95,9 +95,11 @@ TEST(Samples, GatherStreamsChunksInVertexOrder) {
   VisibilityMasks masks;
   masks.vertex_count = 3000;
   masks.raster_count = 2;
-  masks.unoccluded.assign(masks.words() * 2, ~uint64_t(0));
-  masks.unshadowed.assign(masks.words() * 2, ~uint64_t(0));
-  masks.unshadowed[masks.words() + 0] = 0;  // raster 1: vertices 0..63 in cast shadow
+  masks.seen.assign(masks.words() * 2, ~uint64_t(0));
+  masks.lit.assign(masks.words() * 2, ~uint64_t(0));
+  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded}) v->assign(2, 0);
+  masks.lit[masks.words() + 0] = 0;  // raster 1: vertices 0..63 in cast shadow
+  masks.seen[masks.words() + 1] = 0;  // raster 1 does not see vertices 64..127
   GatherSettings settings;
   settings.chunk_sample_bytes = 1024 * sizeof(Sample) * 2;
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
@@ -115,6 +117,21 @@ TEST(Samples, GatherStreamsChunksInVertexOrder) {
   EXPECT_EQ(stats.chunks, 3u);
   EXPECT_EQ(stats.pairs, 6000u);
   EXPECT_EQ(stats.stored, total);
+  EXPECT_EQ(stats.stored, 6000u - 64u);
   EXPECT_EQ(stats.flag_counts[4], 64u);  // kCastShadow is bit 4
   EXPECT_EQ(cache.loads(), 1u);          // same photo file: decoded once
+}
+
+TEST(Samples, MasksTellWhetherARasterSeesAChunk) {
+  VisibilityMasks m;
+  m.vertex_count = 200;
+  m.raster_count = 1;
+  m.seen.assign(m.words(), 0);
+  m.seen[2] = uint64_t(1) << 5;  // vertex 133
+  EXPECT_TRUE(m.sees_any(0, 0, 200));
+  EXPECT_TRUE(m.sees_any(0, 133, 1));
+  EXPECT_FALSE(m.sees_any(0, 0, 133));
+  EXPECT_FALSE(m.sees_any(0, 134, 66));
+  EXPECT_TRUE(m.sees_any(0, 100, 34));
+  EXPECT_FALSE(m.sees_any(0, 10, 0));
 }
