@@ -67,6 +67,12 @@ void estimate_diffuse_chunk(const SampleChunk &chunk, DiffuseEstimate *out) {
         if (is_specular_sample(s)) ++est.n_specular;
         if (is_diffuse_sample(s)) used.push_back(s);
       }
+      if (used.empty())  // fall back to mixed pixels rather than leave the vertex without colour
+        for (uint32_t k = begin; k < end; ++k) {
+          Sample s = chunk.samples[k];
+          s.flags = uint16_t(s.flags & ~kMixedPixel);
+          if (is_diffuse_sample(s)) used.push_back(s), est.from_mixed_pixels = true;
+        }
       if (least_squares_reflectance(used.data(), used.size(), est.rgb)) {
         est.n_rejected = uint16_t(reject_outliers(used, est.rgb));
         if (est.n_rejected) least_squares_reflectance(used.data(), used.size(), est.rgb);

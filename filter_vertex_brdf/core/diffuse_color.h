@@ -8,7 +8,10 @@
 // grazing samples count more). The thesis's "simplified" sum_i P_i / k_d drops the normalisation.
 // One robust pass follows: samples whose luminance residual exceeds 3 scaled MADs (plus 1% of
 // the estimate) are dropped and rho re-solved, which removes shadow-edge and highlight-edge
-// samples the flags missed. Only samples passing is_diffuse_sample() are used.
+// samples the flags missed. Only samples passing is_diffuse_sample() are used; a vertex whose only
+// otherwise usable samples are mixed pixels (silhouette, mesh border, contact with another surface)
+// falls back to them and is marked `from_mixed_pixels` (a colour of lower confidence rather than
+// none).
 #include <cstdint>
 #include <vector>
 
@@ -23,6 +26,7 @@ struct DiffuseEstimate {
   uint16_t n_specular = 0;    // specular samples (R.E > T_s, lit, unsaturated)
   uint16_t n_rejected = 0;    // diffuse samples rejected as outliers
   bool valid = false;         // at least one diffuse sample
+  bool from_mixed_pixels = false;  // estimated from mixed-pixel samples only
 };
 
 // Least-squares reflectance of `count` samples (all assumed diffuse-usable). Returns false when

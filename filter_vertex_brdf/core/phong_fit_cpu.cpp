@@ -192,7 +192,7 @@ void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, Ve
   int n_high = 0;
   for (size_t i = 0; i < count; ++i) {
     const Sample &s = in[i];
-    if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0)) continue;
+    if ((s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) || !(s.n_dot_l > 0)) continue;
     if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.r_dot_e))
       continue;  // a corrupt sample is not evidence
     FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.r_dot_e, s.n_dot_l,

@@ -163,7 +163,8 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings, Visibility
     result.attributes[3].values[v] = e.n_seen;
     result.attributes[4].values[v] = e.n_diffuse;
     result.attributes[5].values[v] = e.n_specular;
-    result.attributes[6].values[v] = e.valid ? 1.0f : 0.0f;
+    result.attributes[6].values[v] = e.valid ? (e.from_mixed_pixels ? 2.0f : 1.0f) : 0.0f;
+    if (e.valid && e.from_mixed_pixels) ++result.vertices_from_mixed;
     if (e.valid) {
       for (int c = 0; c < 3; ++c) result.colors_rgba[4 * v + size_t(c)] = srgb_byte(e.rgb[c]);
       result.colors_rgba[4 * v + 3] = 255;
@@ -171,7 +172,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings, Visibility
     } else {
       for (int c = 0; c < 4; ++c)
         result.colors_rgba[4 * v + size_t(c)] =
-            input.mesh_colors.size() == 4 * n ? input.mesh_colors[4 * v + size_t(c)] : uint8_t(c == 3 ? 255 : 128);
+            input.mesh_colors.size() == 4 * n ? input.mesh_colors[4 * v + size_t(c)] : uint8_t(255);  // MeshLab default: white
       if (e.n_seen == 0) ++result.vertices_unseen; else ++result.vertices_no_diffuse;
     }
   }
@@ -186,13 +187,14 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings, Visibility
       << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
       << ", T_d (N.L) = " << settings.gather.diffuse_threshold << "\n"
       << "vertices coloured: " << result.vertices_coloured << " (" << percent(result.vertices_coloured, n) << ")\n"
+      << "  of which from mixed pixels only (silhouette/border/contact; coloured = 2): " << result.vertices_from_mixed << "\n"
       << "vertices seen but without a diffuse sample (kept their colour): " << result.vertices_no_diffuse << "\n"
       << "vertices seen by no photo (kept their colour; need another viewpoint): " << result.vertices_unseen << "\n"
       << "vertex-photo pairs: " << g.pairs << ", samples stored (seen): " << g.stored << "\n";
   const std::pair<uint16_t, const char *> flag_names[] = {
       {kOffImage, "off image / behind camera"}, {kBackFacing, "back-facing"}, {kOccluded, "occluded"},
       {kAttachedShadow, "facing away from the light"}, {kCastShadow, "in cast shadow"},
-      {kSaturated, "saturated (not used)"}, {kGrazing, "grazing light (N.L < T_d)"}, {kHighlight, "highlight (R.E > T_s)"}};
+      {kSaturated, "saturated (not used)"}, {kMixedPixel, "mixed pixel at a silhouette/border (not used)"}, {kGrazing, "grazing light (N.L < T_d)"}, {kHighlight, "highlight (R.E > T_s)"}};
   for (const auto &f : flag_names)
     rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
   size_t blind = 0;

@@ -57,7 +57,7 @@ struct FitResult {
   std::string light_file;                 // the .lp used
   std::string output_ply;                 // where the PLY was written
   std::string report;                     // human-readable report (also written beside the PLY)
-  size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0;
+  size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;
   double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
 };
 

@@ -51,14 +51,14 @@ namespace {
 // Combines the camera pass with the per-vertex frustum and facing tests into `seen`, counting why
 // vertices are not seen (off image first, then back-facing, then occluded).
 void classify_seen(const MeshView &mesh, const Raster &raster, const std::vector<uint8_t> &clear, uint64_t *seen_words,
-                   uint32_t counts[4]) {
+                   uint64_t *mixed_words, uint32_t counts[4]) {
   float centre[3];
   camera_centre(raster.shot, centre);
   uint64_t off = 0, back = 0, occ = 0, seen = 0;
   const long long words = (long long)((mesh.vertex_count + 63) / 64);
 #pragma omp parallel for reduction(+ : off, back, occ, seen) schedule(static)
   for (long long w = 0; w < words; ++w) {
-    uint64_t bits = 0;
+    uint64_t bits = 0, mixed_bits = 0;
     const size_t end = std::min(mesh.vertex_count, size_t(w + 1) * 64);
     for (size_t v = size_t(w) * 64; v < end; ++v) {
       const float *p = mesh.positions + 3 * v, *n = mesh.normals + 3 * v;
@@ -77,9 +77,11 @@ void classify_seen(const MeshView &mesh, const Raster &raster, const std::vector
         continue;
       }
       bits |= uint64_t(1) << (v % 64);
+      if (clear[v] == 2) mixed_bits |= uint64_t(1) << (v % 64);
       ++seen;
     }
     seen_words[w] = bits;
+    mixed_words[w] = mixed_bits;
   }
   counts[0] = uint32_t(off), counts[1] = uint32_t(back), counts[2] = uint32_t(occ), counts[3] = uint32_t(seen);
 }
@@ -93,6 +95,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
   masks.raster_count = rasters.size();
   masks.seen.assign(masks.words() * rasters.size(), 0);
   masks.lit.assign(masks.words() * rasters.size(), 0);
+  masks.mixed.assign(masks.words() * rasters.size(), 0);
   for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded, &masks.seen_count}) v->assign(rasters.size(), 0);
   std::vector<uint8_t> buffer(mesh.vertex_count);
   for (size_t r = 0; r < rasters.size(); ++r) {
@@ -100,7 +103,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
     std::fill(buffer.begin(), buffer.end(), 0);
     backend.camera_pass(rasters[r].shot, buffer.data());
     uint32_t counts[4];
-    classify_seen(mesh, rasters[r], buffer, &masks.seen[r * masks.words()], counts);
+    classify_seen(mesh, rasters[r], buffer, &masks.seen[r * masks.words()], &masks.mixed[r * masks.words()], counts);
     masks.off_image[r] = counts[0], masks.back_facing[r] = counts[1], masks.occluded[r] = counts[2];
     masks.seen_count[r] = counts[3];
     if (counts[3] == 0) continue;  // a photo that sees nothing needs no shadow pass
@@ -189,6 +192,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
         }
         make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo, true,
                     masks.is_lit(r, v), settings, out);
+        if (masks.is_mixed(r, v)) out.flags |= kMixedPixel;
       }
     }
     // Compact: keep samples seen by the camera, in vertex order.

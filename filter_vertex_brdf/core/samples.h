@@ -27,6 +27,7 @@ enum SampleFlag : uint16_t {
   kSaturated = 1u << 5,       // a channel is clipped in the bilinear footprint
   kGrazing = 1u << 6,         // 0 < N.L < T_d
   kHighlight = 1u << 7,       // R.E > T_s (specular sample)
+  kMixedPixel = 1u << 8,      // the pixel footprint also covers background/another surface
 };
 constexpr uint16_t kNotSeen = kOffImage | kBackFacing | kOccluded;
 constexpr uint16_t kShadowed = kAttachedShadow | kCastShadow;
@@ -40,13 +41,13 @@ struct Sample {
 };
 static_assert(sizeof(Sample) == 24, "Sample must stay compact");
 
-// Usable for the diffuse colour: lit, not grazing, not a highlight, not saturated.
+// Usable for the diffuse colour: lit, not grazing, not a highlight, not saturated, clean pixel.
 inline bool is_diffuse_sample(const Sample &s) {
-  return (s.flags & (kShadowed | kSaturated | kGrazing | kHighlight)) == 0;
+  return (s.flags & (kShadowed | kSaturated | kGrazing | kHighlight | kMixedPixel)) == 0;
 }
-// Usable as specular evidence: lit, unsaturated highlight.
+// Usable as specular evidence: lit, unsaturated, clean highlight.
 inline bool is_specular_sample(const Sample &s) {
-  return (s.flags & (kShadowed | kSaturated)) == 0 && (s.flags & kHighlight) != 0;
+  return (s.flags & (kShadowed | kSaturated | kMixedPixel)) == 0 && (s.flags & kHighlight) != 0;
 }
 
 struct GatherSettings {
@@ -66,10 +67,12 @@ struct VisibilityMasks {
   size_t raster_count = 0;
   std::vector<uint64_t> seen;  // raster-major: word (r * words() + v / 64), bit v % 64
   std::vector<uint64_t> lit;
+  std::vector<uint64_t> mixed;  // seen, but the pixel footprint mixes surfaces (GL back end only)
   std::vector<uint32_t> off_image, back_facing, occluded, seen_count;  // per raster
   size_t words() const { return (vertex_count + 63) / 64; }
   bool is_seen(size_t r, size_t v) const { return (seen[r * words() + v / 64] >> (v % 64)) & 1u; }
   bool is_lit(size_t r, size_t v) const { return (lit[r * words() + v / 64] >> (v % 64)) & 1u; }
+  bool is_mixed(size_t r, size_t v) const { return (mixed[r * words() + v / 64] >> (v % 64)) & 1u; }
   // True when raster r sees at least one vertex in [first, first + count).
   bool sees_any(size_t r, size_t first, size_t count) const;
 };

@@ -24,8 +24,11 @@ class VisibilityBackend {
 public:
   virtual ~VisibilityBackend() = default;
   virtual const char *name() const = 0;
-  // out[v] = 1 when no other geometry hides vertex v from the camera of `shot`, else 0.
-  // Vertices outside the image or behind the camera get 1 (not this pass's concern).
+  // out[v] = 1 when no other geometry hides vertex v from the camera of `shot`, else 0;
+  // 2 when it is not hidden but the 2x2 pixel footprint of its bilinear colour sample also
+  // covers background or another surface (a mixed pixel at a silhouette or mesh border: the
+  // colour is contaminated). Only back ends with a depth map report 2 (GL); the CPU ray caster
+  // reports 1. Vertices outside the image or behind the camera get 1 (not this pass's concern).
   virtual void camera_pass(const Shot &shot, uint8_t *out) = 0;
   // out[v] = 1 when no geometry lies between vertex v and a directional light shining from
   // `dir_world` (unit vector towards the light), else 0 (cast shadow).

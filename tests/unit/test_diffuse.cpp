@@ -83,3 +83,18 @@ TEST(Diffuse, NoUsableSampleGivesInvalidNotNaN) {
   EXPECT_FALSE(est.valid);
   EXPECT_EQ(est.n_seen, 0);
 }
+
+TEST(Diffuse, MixedPixelsAreUsedOnlyWhenNothingCleanRemains) {
+  const float rho[3] = {0.5f, 0.5f, 0.5f}, dark[3] = {0.1f, 0.1f, 0.1f};
+  DiffuseEstimate est;
+  // A clean sample wins over mixed ones.
+  estimate_diffuse_chunk(one_vertex({diffuse_sample(rho, 0.8f), diffuse_sample(dark, 0.8f, 0, kMixedPixel)}), &est);
+  EXPECT_FALSE(est.from_mixed_pixels);
+  EXPECT_NEAR(est.rgb[0], 0.5f, 1e-6);
+  EXPECT_EQ(est.n_diffuse, 1);
+  // Only mixed samples: used, and said so.
+  estimate_diffuse_chunk(one_vertex({diffuse_sample(dark, 0.8f, 0, kMixedPixel)}), &est);
+  EXPECT_TRUE(est.valid);
+  EXPECT_TRUE(est.from_mixed_pixels);
+  EXPECT_NEAR(est.rgb[0], 0.1f, 1e-6);
+}

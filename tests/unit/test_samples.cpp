@@ -97,6 +97,7 @@ TEST(Samples, GatherStreamsChunksInVertexOrder) {
   masks.raster_count = 2;
   masks.seen.assign(masks.words() * 2, ~uint64_t(0));
   masks.lit.assign(masks.words() * 2, ~uint64_t(0));
+  masks.mixed.assign(masks.words() * 2, 0);
   for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded}) v->assign(2, 0);
   masks.lit[masks.words() + 0] = 0;  // raster 1: vertices 0..63 in cast shadow
   masks.seen[masks.words() + 1] = 0;  // raster 1 does not see vertices 64..127

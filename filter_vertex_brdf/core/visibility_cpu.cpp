@@ -1,0 +1,206 @@
+// CPU reference for the visibility contract (visibility.h): one ray per vertex and pass, traced
+// through a vcglib uniform grid over the triangles. Slow but exact up to floating point; the GL
+// passes are tested against it.
+//
+// Why the offset: a ray starting exactly on the vertex hits the vertex's own triangles at t ~ 0
+// (rounding decides), so it starts `tolerance` along the ray. This also gives the same meaning as
+// the GL depth test: the vertex is clear when the first surface along the ray is at most
+// `tolerance` in front of it. Thin features closer than the tolerance (a sheet of paper lying on
+// the surface) therefore do not occlude.
+//
+// Grazing angles: when the ray is nearly tangent to the surface, the offset start point is only
+// tolerance * sin(angle) above the surface, and the curved (or bumpy) surface next to the vertex can
+// block it: vertices near the terminator / silhouette may be reported in cast shadow / occluded.
+// Those vertices have N.L (or N.V) close to 0 and are rejected by the attached-shadow / back-facing
+// tests anyway (samples.cpp). A ray lying exactly in a triangle's plane does not hit that triangle.
+#include "visibility.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <vcg/space/box3.h>
+#include <vcg/space/index/grid_closest.h>
+#include <vcg/space/index/grid_static_ptr.h>
+#include <vcg/space/index/space_iterators.h>
+#include <vcg/space/ray3.h>
+
+#include "errors.h"
+
+namespace vbrdf {
+
+namespace {
+
+// The minimal object vcg::GridStaticPtr indexes: a triangle that can report its bounding box.
+struct GridTriangle {
+  typedef float ScalarType;
+  vcg::Point3f p[3];
+  void GetBBox(vcg::Box3f &b) const {
+    b.Set(p[0]);
+    b.Add(p[1]);
+    b.Add(p[2]);
+  }
+  bool IsD() const { return false; }
+};
+using TriangleGrid = vcg::GridStaticPtr<GridTriangle, float>;
+
+// Double-precision Moller-Trumbore, both faces. vcglib's IntersectionLineTriangle rejects
+// |det| < 1e-6 in absolute terms, which silently misses small triangles of dense meshes.
+struct RayTriangleHit {
+  bool operator()(const GridTriangle &f, const vcg::Ray3f &ray, float &t) const {
+    const double eps = 1e-9;  // slightly inclusive edges: rays through shared edges do not leak
+    double o[3], d[3], a[3], e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+      o[k] = ray.Origin()[k];
+      d[k] = ray.Direction()[k];
+      a[k] = f.p[0][k];
+      e1[k] = double(f.p[1][k]) - a[k];
+      e2[k] = double(f.p[2][k]) - a[k];
+    }
+    const double pv[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+    const double det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
+    if (det == 0) return false;  // ray parallel to the triangle's plane
+    const double inv = 1.0 / det;
+    const double tv[3] = {o[0] - a[0], o[1] - a[1], o[2] - a[2]};
+    const double u = (tv[0] * pv[0] + tv[1] * pv[1] + tv[2] * pv[2]) * inv;
+    if (u < -eps || u > 1 + eps) return false;
+    const double qv[3] = {tv[1] * e1[2] - tv[2] * e1[1], tv[2] * e1[0] - tv[0] * e1[2], tv[0] * e1[1] - tv[1] * e1[0]};
+    const double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) * inv;
+    if (v < -eps || u + v > 1 + eps) return false;
+    const double hit_t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) * inv;
+    if (hit_t < 0) return false;
+    t = float(hit_t);
+    return true;
+  }
+};
+
+// Per-thread "already tested" marks for the ray iterator (a triangle spans several cells).
+// vcglib's FaceTmark writes into the shared mesh, which is not thread-safe.
+struct MarkState {
+  std::vector<uint32_t> stamps;
+  uint32_t current = 0;
+};
+
+class StampMarker {
+public:
+  StampMarker() = default;
+  StampMarker(MarkState *state, const GridTriangle *base) : state_(state), base_(base) {}
+  void UnMarkAll() {
+    if (++state_->current == 0) {  // wrapped: forget every old stamp
+      std::fill(state_->stamps.begin(), state_->stamps.end(), 0u);
+      state_->current = 1;
+    }
+  }
+  bool IsMarked(const GridTriangle *f) const { return state_->stamps[size_t(f - base_)] == state_->current; }
+  void Mark(const GridTriangle *f) { state_->stamps[size_t(f - base_)] = state_->current; }
+
+private:
+  MarkState *state_ = nullptr;
+  const GridTriangle *base_ = nullptr;
+};
+
+class CpuVisibility : public VisibilityBackend {
+public:
+  CpuVisibility(const MeshView &mesh, const VisibilitySettings &settings);
+  const char *name() const override { return "CPU ray casting"; }
+  void camera_pass(const Shot &shot, uint8_t *out) override;
+  void light_pass(const float dir_world[3], uint8_t *out) override;
+
+private:
+  // True when a triangle lies on the ray from `from` along unit `dir` within (0, max_dist].
+  bool blocked(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist);
+
+  MeshView mesh_;
+  float tolerance_ = 0;
+  float diagonal_ = 0;
+  std::vector<GridTriangle> triangles_;
+  TriangleGrid grid_;
+};
+
+CpuVisibility::CpuVisibility(const MeshView &mesh, const VisibilitySettings &settings) : mesh_(mesh) {
+  diagonal_ = compute_bounds(mesh).diagonal();
+  tolerance_ = settings.depth_tolerance * diagonal_;
+  triangles_.reserve(mesh.index_count / 3);
+  for (size_t i = 0; i + 2 < mesh.index_count; i += 3) {
+    GridTriangle t;
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t v = mesh.indices[i + c];
+      if (v >= mesh.vertex_count)
+        throw InputError("CPU visibility: face " + std::to_string(i / 3) + " references vertex " +
+                         std::to_string(v) + " which does not exist.");
+      const float *p = mesh.positions + 3 * size_t(v);
+      t.p[c] = vcg::Point3f(p[0], p[1], p[2]);
+    }
+    triangles_.push_back(t);
+  }
+  if (!triangles_.empty()) grid_.Set(triangles_.begin(), triangles_.end());
+}
+
+bool CpuVisibility::blocked(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist) {
+  if (triangles_.empty() || !(max_dist > 0)) return false;
+  RayTriangleHit hit;
+  StampMarker marker(&marks, triangles_.data());
+  float t = 0;
+  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) != nullptr;
+}
+
+void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
+  if (!shot_is_valid(shot))
+    throw InputError("CPU visibility: the camera of the raster is not valid (zero focal length, pixel size, "
+                     "viewport or rotation): check the raster's <VCGCamera>.");
+  float c[3];
+  camera_centre(shot, c);
+  const vcg::Point3f centre(c[0], c[1], c[2]);
+  const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
+  const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
+#pragma omp parallel
+  {
+    MarkState marks;
+    marks.stamps.assign(triangles_.size(), 0u);
+#pragma omp for schedule(dynamic, 256)
+    for (ptrdiff_t v = 0; v < n; ++v) {
+      const float *p = mesh_.positions + 3 * v;
+      const ImagePoint ip = project_to_image(shot, p);
+      if (!ip.in_front || !(ip.x >= 0 && ip.x < width && ip.y >= 0 && ip.y < height)) {
+        out[v] = 1;
+        continue;
+      }
+      const vcg::Point3f pos(p[0], p[1], p[2]);
+      vcg::Point3f dir = centre - pos;
+      const float dist = dir.Norm();
+      dir /= dist;
+      // Segment from the offset start to the camera centre.
+      out[v] = blocked(marks, pos + dir * tolerance_, dir, dist - tolerance_) ? 0 : 1;
+    }
+  }
+}
+
+void CpuVisibility::light_pass(const float dir_world[3], uint8_t *out) {
+  vcg::Point3f dir(dir_world[0], dir_world[1], dir_world[2]);
+  const float len = dir.Norm();
+  if (!(len > 1e-12f) || !std::isfinite(len)) throw InputError("CPU visibility: the light direction is zero or not finite.");
+  dir /= len;
+  // Any occluder lies within the bounding box, hence within one diagonal of the vertex.
+  const float max_dist = 2 * diagonal_ + tolerance_;
+  const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
+#pragma omp parallel
+  {
+    MarkState marks;
+    marks.stamps.assign(triangles_.size(), 0u);
+#pragma omp for schedule(dynamic, 256)
+    for (ptrdiff_t v = 0; v < n; ++v) {
+      const float *p = mesh_.positions + 3 * v;
+      const vcg::Point3f pos(p[0], p[1], p[2]);
+      out[v] = blocked(marks, pos + dir * tolerance_, dir, max_dist) ? 0 : 1;
+    }
+  }
+}
+
+} // namespace
+
+std::unique_ptr<VisibilityBackend> make_cpu_visibility(const MeshView &mesh, const VisibilitySettings &settings) {
+  return std::unique_ptr<VisibilityBackend>(new CpuVisibility(mesh, settings));
+}
+
+} // namespace vbrdf

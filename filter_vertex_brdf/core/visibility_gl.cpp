@@ -1,0 +1,407 @@
+// GL depth passes (contract in visibility.h / visibility_gl.h). The mesh is uploaded once; each
+// pass renders the linear view depth of the nearest surface into an R32F target, reads it back and
+// tests every vertex on the CPU against the 2x2 texels around its projection.
+#include "visibility_gl.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <climits>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "errors.h"
+#include "gl_api.h"
+
+namespace vbrdf {
+
+namespace {
+
+// Linear depth along the viewing axis (positive in front of a camera), exact per fragment since
+// varyings are interpolated perspective-correctly.
+const char *const kDepthVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_view;
+uniform mat4 u_projection;
+out float v_depth;
+void main() {
+  vec4 view_pos = u_view * vec4(a_position, 1.0);
+  v_depth = -view_pos.z;
+  gl_Position = u_projection * view_pos;
+}
+)";
+
+const char *const kDepthFragmentShader = R"(#version 330 core
+in float v_depth;
+layout(location = 0) out float o_depth;
+void main() { o_depth = v_depth; }
+)";
+
+// Background value: farther than anything, so vertices next to the mesh silhouette stay clear.
+const float kFarAway = FLT_MAX;
+
+// Column-major 4x4 matrix, as GL takes it.
+struct Mat4 {
+  float m[16] = {0};
+  float &at(int row, int col) { return m[col * 4 + row]; }
+  float at(int row, int col) const { return m[col * 4 + row]; }
+};
+
+void transform(const Mat4 &a, const float p[3], float out[4]) {
+  for (int row = 0; row < 4; ++row)
+    out[row] = a.at(row, 0) * p[0] + a.at(row, 1) * p[1] + a.at(row, 2) * p[2] + a.at(row, 3);
+}
+
+// True when `depth` is at most `tol` behind the farthest of the 2x2 texels nearest to the window
+// point (wx, wy) (GL window coordinates, texel centres at integer + 0.5). Taking the farthest of
+// the bilinear footprint forgives the half-pixel quantisation at silhouettes and steep slopes.
+inline bool depth_clear(const float *map, int w, int h, float wx, float wy, float depth, float tol) {
+  const int i0 = int(std::floor(wx - 0.5f)), j0 = int(std::floor(wy - 0.5f));
+  const int xa = std::min(std::max(i0, 0), w - 1), xb = std::min(std::max(i0 + 1, 0), w - 1);
+  const int ya = std::min(std::max(j0, 0), h - 1), yb = std::min(std::max(j0 + 1, 0), h - 1);
+  const float *ra = map + size_t(ya) * size_t(w), *rb = map + size_t(yb) * size_t(w);
+  const float far_depth = std::max(std::max(ra[xa], ra[xb]), std::max(rb[xa], rb[xb]));
+  return depth <= far_depth + tol;
+}
+
+// True when every texel of the 2x2 footprint shows the vertex's own surface: its depth within
+// `allowed` of the vertex depth. A footprint that also covers background or another surface gives
+// a mixed (contaminated) bilinear colour sample.
+inline bool footprint_clean(const float *map, int w, int h, float wx, float wy, float depth, float allowed) {
+  const int i0 = int(std::floor(wx - 0.5f)), j0 = int(std::floor(wy - 0.5f));
+  for (int j = j0; j <= j0 + 1; ++j)
+    for (int i = i0; i <= i0 + 1; ++i) {
+      if (i < 0 || j < 0 || i >= w || j >= h) return false;
+      if (std::fabs(map[size_t(j) * size_t(w) + size_t(i)] - depth) > allowed) return false;
+    }
+  return true;
+}
+
+// An FBO with an R32F colour texture (linear depth) and a 32F depth renderbuffer.
+struct DepthTarget {
+  GLuint fbo = 0, color = 0, depth = 0;
+  int width = 0, height = 0;
+};
+
+class GlVisibility : public VisibilityBackend {
+public:
+  GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_proc, const VisibilitySettings &settings);
+  ~GlVisibility() override;
+  const char *name() const override { return "OpenGL"; }
+  void camera_pass(const Shot &shot, uint8_t *out) override;
+  void light_pass(const float dir_world[3], uint8_t *out) override;
+
+private:
+  void check_target_size(int width, int height, const std::string &what) const;
+  void upload_mesh();
+  void ensure_target(DepthTarget &target, int width, int height, const std::string &what);
+  void release_target(DepthTarget &target);
+  void release_gl();
+  void render_depth(const DepthTarget &target, const Mat4 &view, const Mat4 &projection, const std::string &what);
+  void fill(uint8_t *out, uint8_t value) const;
+
+  MeshView mesh_;
+  VisibilitySettings settings_;
+  GlApi gl_;
+  float origin_[3] = {0, 0, 0};  // bounding-box centre: positions are uploaded relative to it
+  float corners_[8][3] = {};     // bounding-box corners, relative to origin_
+  float radius_ = 0;             // bounding sphere radius around origin_
+  float tolerance_ = 0;          // settings.depth_tolerance * bbox diagonal (world units)
+  GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+  GLint u_view_ = -1, u_projection_ = -1;
+  DepthTarget camera_target_, light_target_;
+  std::vector<float> depth_;     // read-back buffer, reused between passes
+};
+
+GlVisibility::GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_proc, const VisibilitySettings &settings)
+    : mesh_(mesh), settings_(settings), gl_(load_gl_api(get_proc)) {
+  if (mesh.index_count > size_t(INT_MAX))
+    throw ProcessingError("OpenGL visibility: the mesh has " + std::to_string(mesh.index_count / 3) +
+                          " triangles, more than one OpenGL draw call can take.");
+  for (size_t i = 0; i < mesh.index_count; ++i)
+    if (mesh.indices[i] >= mesh.vertex_count)  // an out-of-range index can crash the GL driver
+      throw InputError("OpenGL visibility: face " + std::to_string(i / 3) + " references vertex " +
+                       std::to_string(mesh.indices[i]) + " which does not exist.");
+  if (settings.shadow_map_size <= 0)
+    throw InputError("OpenGL visibility: the shadow map size must be positive (got " +
+                     std::to_string(settings.shadow_map_size) + ").");
+  check_target_size(settings.shadow_map_size, settings.shadow_map_size, "the light-view shadow map");
+
+  const Bounds b = compute_bounds(mesh);
+  tolerance_ = settings.depth_tolerance * b.diagonal();
+  if (mesh.vertex_count > 0) {
+    for (int k = 0; k < 3; ++k) origin_[k] = 0.5f * (b.min[k] + b.max[k]);
+    for (int c = 0; c < 8; ++c)
+      for (int k = 0; k < 3; ++k) corners_[c][k] = ((c >> k) & 1 ? b.max[k] : b.min[k]) - origin_[k];
+  }
+
+  GlStateGuard guard(gl_);
+  clear_gl_errors(gl_);  // errors left by the host are not ours
+  try {
+    program_ = build_program(gl_, kDepthVertexShader, kDepthFragmentShader, "the visibility depth pass");
+    u_view_ = gl_.GetUniformLocation(program_, "u_view");
+    u_projection_ = gl_.GetUniformLocation(program_, "u_projection");
+    upload_mesh();
+    check_gl_error(gl_, "the upload of the mesh for the visibility passes");
+  } catch (...) {
+    release_gl();  // the destructor does not run when the constructor throws
+    throw;
+  }
+}
+
+GlVisibility::~GlVisibility() { release_gl(); }
+
+void GlVisibility::release_gl() {
+  release_target(camera_target_);
+  release_target(light_target_);
+  if (vao_) gl_.DeleteVertexArrays(1, &vao_);
+  if (vbo_) gl_.DeleteBuffers(1, &vbo_);
+  if (ibo_) gl_.DeleteBuffers(1, &ibo_);
+  if (program_) gl_.DeleteProgram(program_);
+  vao_ = vbo_ = ibo_ = program_ = 0;
+}
+
+void GlVisibility::check_target_size(int width, int height, const std::string &what) const {
+  GLint max_texture = 0, max_renderbuffer = 0, max_viewport[2] = {0, 0};
+  gl_.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+  gl_.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+  gl_.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+  const int limit_x = std::min(std::min(max_texture, max_renderbuffer), max_viewport[0]);
+  const int limit_y = std::min(std::min(max_texture, max_renderbuffer), max_viewport[1]);
+  if (width > limit_x || height > limit_y)
+    throw ProcessingError("OpenGL visibility: " + what + " needs a " + std::to_string(width) + "x" +
+                          std::to_string(height) + " render target, but this OpenGL (" + gl_.version_string() +
+                          ") allows at most " + std::to_string(limit_x) + "x" + std::to_string(limit_y) +
+                          ". Use smaller photos / shadow map, or the CPU visibility.");
+}
+
+void GlVisibility::upload_mesh() {
+  // Relative to the bounding-box centre so that far-from-origin (georeferenced) coordinates keep
+  // their precision in the float vertex transform.
+  std::vector<float> local(mesh_.vertex_count * 3);
+  for (size_t v = 0; v < mesh_.vertex_count; ++v)
+    for (int k = 0; k < 3; ++k) local[3 * v + k] = mesh_.positions[3 * v + k] - origin_[k];
+  float r2 = 0;
+  for (size_t v = 0; v < mesh_.vertex_count; ++v) {
+    const float *p = &local[3 * v];
+    r2 = std::max(r2, p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+  }
+  radius_ = std::sqrt(r2);
+
+  gl_.GenVertexArrays(1, &vao_);
+  gl_.BindVertexArray(vao_);
+  gl_.GenBuffers(1, &vbo_);
+  gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
+  gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(local.size() * sizeof(float)), local.data(), GL_STATIC_DRAW);
+  gl_.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  gl_.EnableVertexAttribArray(0);
+  gl_.GenBuffers(1, &ibo_);
+  gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);  // recorded in our VAO only
+  gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh_.index_count * sizeof(uint32_t)), mesh_.indices,
+                 GL_STATIC_DRAW);
+}
+
+void GlVisibility::ensure_target(DepthTarget &t, int width, int height, const std::string &what) {
+  if (t.fbo && t.width == width && t.height == height) return;
+  check_target_size(width, height, what);
+  if (!t.fbo) {
+    gl_.GenFramebuffers(1, &t.fbo);
+    gl_.GenTextures(1, &t.color);
+    gl_.GenRenderbuffers(1, &t.depth);
+  }
+  gl_.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
+  gl_.BindTexture(GL_TEXTURE_2D, t.color);
+  gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width, height, 0, GL_RED, GL_FLOAT, nullptr);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  gl_.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
+  gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
+  gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+  const GLenum draw_buffer = GL_COLOR_ATTACHMENT0;
+  gl_.DrawBuffers(1, &draw_buffer);
+  gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  check_gl_error(gl_, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
+                          " render target for " + what);
+  check_framebuffer(gl_, GL_FRAMEBUFFER, what);
+  t.width = width;
+  t.height = height;
+}
+
+void GlVisibility::release_target(DepthTarget &t) {
+  if (t.fbo) gl_.DeleteFramebuffers(1, &t.fbo);
+  if (t.color) gl_.DeleteTextures(1, &t.color);
+  if (t.depth) gl_.DeleteRenderbuffers(1, &t.depth);
+  t = DepthTarget();
+}
+
+// Renders the nearest linear depth into `t` and reads it back into depth_ (GL row order: row 0 is
+// the bottom of the image). The caller holds a GlStateGuard.
+void GlVisibility::render_depth(const DepthTarget &t, const Mat4 &view, const Mat4 &projection,
+                                const std::string &what) {
+  gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  gl_.Viewport(0, 0, t.width, t.height);
+  set_plain_raster_state(gl_);
+  gl_.Enable(GL_DEPTH_TEST);
+  const float clear_color[4] = {kFarAway, kFarAway, kFarAway, kFarAway}, clear_depth = 1.0f;
+  gl_.ClearBufferfv(GL_COLOR, 0, clear_color);
+  gl_.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
+
+  gl_.UseProgram(program_);
+  gl_.UniformMatrix4fv(u_view_, 1, GL_FALSE, view.m);
+  gl_.UniformMatrix4fv(u_projection_, 1, GL_FALSE, projection.m);
+  gl_.BindVertexArray(vao_);
+  if (mesh_.index_count > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(mesh_.index_count), GL_UNSIGNED_INT, nullptr);
+
+  depth_.resize(size_t(t.width) * size_t(t.height));
+  gl_.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl_.PixelStorei(GL_PACK_ROW_LENGTH, 0);
+  gl_.PixelStorei(GL_PACK_SKIP_ROWS, 0);
+  gl_.PixelStorei(GL_PACK_SKIP_PIXELS, 0);
+  gl_.ReadPixels(0, 0, t.width, t.height, GL_RED, GL_FLOAT, depth_.data());
+  check_gl_error(gl_, what);
+}
+
+void GlVisibility::fill(uint8_t *out, uint8_t value) const { std::fill(out, out + mesh_.vertex_count, value); }
+
+void GlVisibility::camera_pass(const Shot &shot, uint8_t *out) {
+  if (!shot_is_valid(shot))
+    throw InputError("OpenGL visibility: the camera of the raster is not valid (zero focal length, pixel size, "
+                     "viewport or rotation): check the raster's <VCGCamera>.");
+  const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
+
+  // View matrix on recentred positions: the rotation of gl_view_matrix with the translation
+  // R (origin - C) computed in double (no cancellation of large world coordinates).
+  Mat4 world_view;
+  gl_view_matrix(shot, world_view.m);
+  float centre[3];
+  camera_centre(shot, centre);
+  Mat4 view = world_view;
+  for (int row = 0; row < 3; ++row) {
+    double t = 0;
+    for (int k = 0; k < 3; ++k) t += double(world_view.at(row, k)) * (double(origin_[k]) - double(centre[k]));
+    view.at(row, 3) = float(t);
+  }
+
+  // Near/far from the bounding box as seen from the camera; near > 0 even when the camera is inside.
+  float min_depth = FLT_MAX, max_depth = -FLT_MAX;
+  for (const auto &c : corners_) {
+    float v[4];
+    transform(view, c, v);
+    min_depth = std::min(min_depth, -v[2]);
+    max_depth = std::max(max_depth, -v[2]);
+  }
+  if (mesh_.vertex_count == 0 || !(max_depth > 0)) {  // everything behind the camera
+    fill(out, 1);
+    return;
+  }
+  const float far_dist = max_depth * 1.01f + tolerance_;
+  const float near_dist = std::max(min_depth * 0.99f, far_dist * 1e-4f);
+  Mat4 projection;
+  gl_projection_matrix(shot, near_dist, far_dist, projection.m);
+
+  {
+    GlStateGuard guard(gl_);
+    clear_gl_errors(gl_);
+    ensure_target(camera_target_, width, height, "the camera depth pass");
+    render_depth(camera_target_, view, projection, "the camera depth pass");
+  }
+
+  // GL rasterised without lens distortion: look vertices up with the undistorted projection.
+  const bool distorted = shot.Intrinsics.k[0] != 0;
+  Shot undistorted = shot;
+  for (float &k : undistorted.Intrinsics.k) k = 0;
+  const float *map = depth_.data();
+  const float tol = tolerance_;
+  const float focal_px = shot.Intrinsics.FocalMm / shot.Intrinsics.PixelSizeMm[0];
+  const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
+#pragma omp parallel for schedule(static)
+  for (ptrdiff_t v = 0; v < n; ++v) {
+    const float *p = mesh_.positions + 3 * v;
+    const ImagePoint ip = project_to_image(shot, p);
+    if (!ip.in_front || !(ip.x >= 0 && ip.x < width && ip.y >= 0 && ip.y < height)) {
+      out[v] = 1;
+      continue;
+    }
+    const ImagePoint lp = distorted ? project_to_image(undistorted, p) : ip;
+    // Image y down -> GL window y up (GL row 0 is image row height - 1).
+    const float depth = view_depth(shot, p), wx = lp.x, wy = float(height) - lp.y;
+    if (!depth_clear(map, width, height, wx, wy, depth, tol)) {
+      out[v] = 0;
+      continue;
+    }
+    // On the vertex's own (continuous) surface depth changes across a texel by at most about
+    // (world size of a texel) * tan(view angle); allowing the steepest useful slope (tan = 5, a
+    // 79-degree view angle) over 1.5 texels keeps creases and steep faces clean while background
+    // and separate surfaces (depth jumps) still count as mixed.
+    const float allowed = tol + 1.5f * depth / focal_px * 5.0f;
+    out[v] = footprint_clean(map, width, height, wx, wy, depth, allowed) ? 1 : 2;
+  }
+}
+
+void GlVisibility::light_pass(const float dir_world[3], uint8_t *out) {
+  const double len = std::sqrt(double(dir_world[0]) * dir_world[0] + double(dir_world[1]) * dir_world[1] +
+                               double(dir_world[2]) * dir_world[2]);
+  if (!(len > 1e-12) || !std::isfinite(len))
+    throw InputError("OpenGL visibility: the light direction is zero or not finite.");
+  if (mesh_.vertex_count == 0) return;
+  const float d[3] = {float(dir_world[0] / len), float(dir_world[1] / len), float(dir_world[2] / len)};
+
+  // Light frame: z towards the light (GL looks along -z), x/y any orthonormal pair.
+  const int a = std::fabs(d[0]) < 0.6f ? 0 : (std::fabs(d[1]) < 0.6f ? 1 : 2);
+  float helper[3] = {0, 0, 0};
+  helper[a] = 1;
+  float x[3] = {helper[1] * d[2] - helper[2] * d[1], helper[2] * d[0] - helper[0] * d[2],
+                helper[0] * d[1] - helper[1] * d[0]};
+  const float xl = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  for (float &c : x) c /= xl;
+  const float y[3] = {d[1] * x[2] - d[2] * x[1], d[2] * x[0] - d[0] * x[2], d[0] * x[1] - d[1] * x[0]};
+
+  // The bounding sphere is centred on origin_, so the view is a pure rotation of the uploaded
+  // positions; orthographic over the sphere, with light-space depth in [-r, r].
+  const float r = std::max(radius_ * 1.01f + tolerance_, 1e-12f);
+  Mat4 view, projection;
+  for (int k = 0; k < 3; ++k) {
+    view.at(0, k) = x[k];
+    view.at(1, k) = y[k];
+    view.at(2, k) = d[k];
+  }
+  view.at(3, 3) = 1;
+  projection.at(0, 0) = 1 / r;
+  projection.at(1, 1) = 1 / r;
+  projection.at(2, 2) = -1 / r;
+  projection.at(3, 3) = 1;
+
+  const int size = settings_.shadow_map_size;
+  {
+    GlStateGuard guard(gl_);
+    clear_gl_errors(gl_);
+    ensure_target(light_target_, size, size, "the light-view shadow map");
+    render_depth(light_target_, view, projection, "the light-view shadow map pass");
+  }
+
+  const float *map = depth_.data();
+  const float tol = tolerance_, scale = 0.5f * size / r;
+  const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
+#pragma omp parallel for schedule(static)
+  for (ptrdiff_t v = 0; v < n; ++v) {
+    const float *p = mesh_.positions + 3 * v;
+    const float local[3] = {p[0] - origin_[0], p[1] - origin_[1], p[2] - origin_[2]};
+    const float lx = x[0] * local[0] + x[1] * local[1] + x[2] * local[2];
+    const float ly = y[0] * local[0] + y[1] * local[1] + y[2] * local[2];
+    const float depth = -(d[0] * local[0] + d[1] * local[1] + d[2] * local[2]);
+    out[v] = depth_clear(map, size, size, lx * scale + 0.5f * size, ly * scale + 0.5f * size, depth, tol) ? 1 : 0;
+  }
+}
+
+} // namespace
+
+std::unique_ptr<VisibilityBackend> make_gl_visibility(const MeshView &mesh, const GetProcAddressFn &get_proc,
+                                                      const VisibilitySettings &settings) {
+  return std::unique_ptr<VisibilityBackend>(new GlVisibility(mesh, get_proc, settings));
+}
+
+} // namespace vbrdf

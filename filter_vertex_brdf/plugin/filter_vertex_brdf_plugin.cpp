@@ -1,0 +1,80 @@
+#include "filter_vertex_brdf_plugin.h"
+
+#include <exception>
+#include <string>
+
+#include "core/errors.h"
+#include "fit_filter.h"
+
+using vbrdf_plugin::PluginFilter;
+
+FilterVertexBrdfPlugin::FilterVertexBrdfPlugin() {
+  // Order = FilterIDType: append new filters at the end.
+  filters_.emplace_back(new vbrdf_plugin::FitFilter());
+
+  for (size_t id = 0; id < filters_.size(); ++id) {
+    typeList << FilterIDType(id);
+    actionList << new QAction(filters_[id]->name(), this);
+  }
+}
+
+FilterVertexBrdfPlugin::~FilterVertexBrdfPlugin() = default;
+
+QString FilterVertexBrdfPlugin::pluginName() const { return "FilterVertexBrdf"; }
+
+QString FilterVertexBrdfPlugin::filterName(FilterIDType id) const {
+  return (id >= 0 && size_t(id) < filters_.size()) ? filters_[id]->name() : QString();
+}
+
+QString FilterVertexBrdfPlugin::filterInfo(FilterIDType id) const {
+  return (id >= 0 && size_t(id) < filters_.size()) ? filters_[id]->info() : QString();
+}
+
+const PluginFilter &FilterVertexBrdfPlugin::filterOf(QAction *action) const {
+  return *filters_.at(size_t(ID(action)));
+}
+
+MeshFilterInterface::FilterClass FilterVertexBrdfPlugin::getClass(QAction *action) {
+  return filterOf(action).filterClass();
+}
+
+MeshFilterInterface::FILTER_ARITY FilterVertexBrdfPlugin::filterArity(QAction *action) const {
+  return filterOf(action).arity();
+}
+
+int FilterVertexBrdfPlugin::getRequirements(QAction *action) { return filterOf(action).requirements(); }
+
+int FilterVertexBrdfPlugin::getPreConditions(QAction *action) const { return filterOf(action).preConditions(); }
+
+int FilterVertexBrdfPlugin::postCondition(QAction *action) const { return filterOf(action).postConditions(); }
+
+void FilterVertexBrdfPlugin::initParameterSet(QAction *action, MeshDocument &md, RichParameterList &params) {
+  // Never dereference md.mm() here: meshlabserver's -d dump calls this on an empty document.
+  filterOf(action).initParameters(md, params);
+}
+
+bool FilterVertexBrdfPlugin::applyFilter(QAction *action, MeshDocument &md, const RichParameterList &params,
+                                         vcg::CallBackPos *cb) {
+  const PluginFilter &filter = filterOf(action);
+  errorMessage.clear();
+  vbrdf_plugin::FilterRun run{md, params, cb, glContext,
+                              [this](GLLogStream::Levels level, const std::string &line) { Log(level, line); }};
+  std::string failure;
+  try {
+    filter.apply(run);
+    return true;
+  } catch (const vbrdf::InputError &e) {
+    failure = e.what();
+  } catch (const vbrdf::ProcessingError &e) {
+    failure = std::string("processing failed: ") + e.what();
+  } catch (const std::bad_alloc &) {
+    failure = "out of memory: lower 'memoryBudgetMB' or simplify the mesh";
+  } catch (const std::exception &e) {
+    failure = std::string("unexpected error: ") + e.what();
+  }
+  errorMessage = QString::fromStdString(failure);
+  // meshlabserver never prints errorMsg(), only the log: put the reason there too so that
+  // headless runs say why they failed (the GUI shows errorMessage in its failure dialog).
+  Log(GLLogStream::WARNING, filter.name().toStdString() + " failed: " + failure);
+  return false;
+}

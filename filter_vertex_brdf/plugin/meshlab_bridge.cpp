@@ -1,0 +1,190 @@
+#include "meshlab_bridge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <thread>
+
+#include <QDir>
+#include <QFileInfo>
+
+#include <vcg/complex/allocate.h>
+
+#include "core/errors.h"
+
+namespace vbrdf_plugin {
+
+namespace {
+
+bool is_identity(const Matrix44m &m) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (m[r][c] != (r == c ? 1.0f : 0.0f)) return false;
+  return true;
+}
+
+std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
+
+} // namespace
+
+MeshArrays mesh_arrays(const MeshModel &mesh) {
+  const CMeshO &cm = mesh.cm;
+  const std::string name = utf8(mesh.label());
+  MeshArrays out;
+  std::vector<int64_t> array_index(cm.vert.size(), -1);
+  const bool transformed = out.transformed = !is_identity(cm.Tr);
+  // Normals transform with the inverse transpose of the linear part.
+  Matrix44m normal_matrix = vcg::Inverse(cm.Tr);
+  normal_matrix.transposeInPlace();
+
+  bool any_normal = false;
+  for (size_t i = 0; i < cm.vert.size(); ++i) {
+    const CVertexO &v = cm.vert[i];
+    if (v.IsD()) continue;
+    array_index[i] = int64_t(out.vertex_index.size());
+    out.vertex_index.push_back(i);
+    vcg::Point3f p = v.cP(), n = v.cN();
+    if (transformed) {
+      p = cm.Tr * p;
+      vcg::Point4f n4 = normal_matrix * vcg::Point4f(n[0], n[1], n[2], 0.0f);
+      n = vcg::Point3f(n4[0], n4[1], n4[2]);
+      if (n.Norm() > 0) n.Normalize();
+    }
+    for (int k = 0; k < 3; ++k) {
+      out.data.positions.push_back(p[k]);
+      out.data.normals.push_back(n[k]);
+    }
+    if (n[0] != 0 || n[1] != 0 || n[2] != 0) any_normal = true;
+    const vcg::Color4b &c = v.cC();  // always present in CMeshO (white when never set)
+    for (int k = 0; k < 4; ++k) out.data.colors.push_back(c[k]);
+  }
+  if (!out.vertex_index.empty() && !any_normal)
+    throw vbrdf::InputError("Mesh '" + name + "' has no per-vertex normals (all are zero). Compute them with "
+                            "Filters > Normals, Curvatures and Orientation > \"Re-Compute Vertex Normals\" "
+                            "(or \"Compute normals for point sets\"), then apply the filter again.");
+
+  for (size_t f = 0; f < cm.face.size(); ++f) {
+    const CFaceO &face = cm.face[f];
+    if (face.IsD()) continue;
+    for (int k = 0; k < 3; ++k) {
+      const size_t vi = vcg::tri::Index(cm, face.cV(k));
+      if (vi >= array_index.size() || array_index[vi] < 0)
+        throw vbrdf::InputError("Mesh '" + name + "': face " + std::to_string(f) +
+                                " references a deleted vertex (inconsistent mesh): save the layer, "
+                                "reload it and try again.");
+      out.data.indices.push_back(uint32_t(array_index[vi]));
+    }
+  }
+  return out;
+}
+
+std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document) {
+  std::vector<vbrdf::Raster> rasters;
+  for (const RasterModel *rm : document.rasterList) {
+    vbrdf::Raster r;
+    r.label = utf8(rm->label());
+    if (rm->planeList.empty() || rm->planeList.first() == nullptr)
+      throw vbrdf::InputError("Raster '" + r.label + "' has no image: add its photo (a <Plane fileName=...> in the "
+                              ".mlp) or remove the raster.");
+    // The first plane is the photo (MeshLab's .mlp reader keeps only the first).
+    r.image_path = utf8(rm->planeList.first()->fullPathFileName);
+    r.shot = rm->shot;  // Shotm is vcg::Shot<float> with MESHLAB_SCALAR=float
+    rasters.push_back(r);
+  }
+  return rasters;
+}
+
+std::string project_path(const MeshDocument &document, const MeshModel &mesh) {
+  // The document's file name is private in 2020.09; both meshlabserver and the GUI set the
+  // document label to the project's path when they open a project ("Project_N" otherwise).
+  const QFileInfo project(document.docLabel());
+  const QString suffix = project.suffix().toLower();
+  if (project.isAbsolute() && project.isFile() && (suffix == "mlp" || suffix == "mlb"))
+    return utf8(project.absoluteFilePath());
+  if (!mesh.fullName().isEmpty()) return utf8(QFileInfo(mesh.fullName()).absoluteFilePath());
+  return std::string();
+}
+
+std::string resolve_path(const std::string &path, const std::string &project) {
+  if (path.empty()) return path;
+  const QString p = QString::fromStdString(path);
+  if (QFileInfo(p).isAbsolute() || project.empty()) return utf8(QFileInfo(p).absoluteFilePath());
+  const QDir base = QFileInfo(QString::fromStdString(project)).absoluteDir();
+  return utf8(QDir::cleanPath(base.absoluteFilePath(p)));
+}
+
+void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint8_t> &colors_rgba,
+                   const std::vector<vbrdf::VertexAttribute> &attributes) {
+  CMeshO &cm = mesh.cm;
+  const size_t n = arrays.vertex_index.size();
+  mesh.updateDataMask(MeshModel::MM_VERTCOLOR);
+  if (colors_rgba.size() == 4 * n)
+    for (size_t i = 0; i < n; ++i) {
+      const uint8_t *c = &colors_rgba[4 * i];
+      cm.vert[arrays.vertex_index[i]].C() = vcg::Color4b(c[0], c[1], c[2], c[3]);
+    }
+  for (const vbrdf::VertexAttribute &attr : attributes) {
+    if (attr.values.size() != n || attr.name.empty()) continue;
+    using Alloc = vcg::tri::Allocator<CMeshO>;
+    // A same-named attribute of another type would make GetPerVertexAttribute assert.
+    if (Alloc::IsValidHandle(cm, Alloc::FindPerVertexAttribute<float>(cm, attr.name)) == false &&
+        vcg::tri::HasPerVertexAttribute(cm, attr.name))
+      Alloc::DeletePerVertexAttribute(cm, attr.name);
+    auto handle = Alloc::GetPerVertexAttribute<float>(cm, attr.name);
+    for (size_t i = 0; i < n; ++i) handle[arrays.vertex_index[i]] = attr.values[i];
+  }
+}
+
+GlContextScope::GlContextScope(MLPluginGLContext *context, const std::function<void(const std::string &)> &log) {
+  if (context == nullptr) return;  // CPU chosen, or no view: the core says which back end runs
+  if (!context->isValid()) {
+    log("MeshLab's OpenGL context is not valid: visibility runs on the CPU.");
+    return;
+  }
+  context->makeCurrent();
+  if (QGLContext::currentContext() != context) {
+    log("MeshLab's OpenGL context could not be made current: visibility runs on the CPU.");
+    return;
+  }
+  context_ = context;
+}
+
+GlContextScope::~GlContextScope() {
+  if (context_ != nullptr) context_->doneCurrent();
+}
+
+std::function<void *(const char *)> GlContextScope::get_proc() const {
+  if (context_ == nullptr) return {};
+  // QGLContext::getProcAddress, not QOpenGLContext: QtGui's GL headers clash with GLEW's,
+  // which MeshLab's headers include.
+  const QGLContext *context = context_;
+  return [context](const char *name) -> void * {
+    return reinterpret_cast<void *>(context->getProcAddress(QString::fromLatin1(name)));
+  };
+}
+
+vbrdf::ProgressFn progress_adapter(vcg::CallBackPos *cb, const std::string &prefix) {
+  if (cb == nullptr) return {};
+  struct State {
+    std::thread::id owner = std::this_thread::get_id();
+    int last_percent = -100;
+    std::string last_stage, text;
+  };
+  auto state = std::make_shared<State>();
+  return [cb, prefix, state](float fraction, const char *stage) -> bool {
+    if (std::this_thread::get_id() != state->owner) return true;
+    const float f = std::isfinite(fraction) ? std::min(1.0f, std::max(0.0f, fraction)) : 0.0f;
+    const int percent = int(f * 100.0f);
+    const std::string stage_name = stage != nullptr ? stage : "";
+    // meshlabserver prints every call: report stage changes and 5% steps only.
+    if (stage_name == state->last_stage && percent < state->last_percent + 5 && percent != 100) return true;
+    if (stage_name == state->last_stage && percent == state->last_percent) return true;
+    state->last_percent = percent;
+    state->last_stage = stage_name;
+    // Trailing newline: meshlabserver prints the text as is; the GUI status bar ignores it.
+    state->text = prefix + stage_name + " (" + std::to_string(percent) + "%)\n";
+    return cb(percent, state->text.c_str());
+  };
+}
+
+} // namespace vbrdf_plugin

@@ -1,0 +1,64 @@
+#pragma once
+// MeshLab document <-> core types. No algorithm here: plain copies and index maps.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <common/interfaces.h>
+
+#include "core/camera.h"
+#include "core/mesh_view.h"
+#include "core/output_ply.h"
+#include "core/samples.h"
+
+namespace vbrdf_plugin {
+
+// The mesh as plain arrays in world coordinates (cm.Tr applied, as MeshLab displays it), with
+// deleted vertices and faces skipped. vertex_index[i] is the CMeshO vertex of array vertex i.
+struct MeshArrays {
+  vbrdf::MeshData data;              // positions, normals, indices, colors (RGBA8)
+  std::vector<size_t> vertex_index;
+  bool transformed = false;          // the layer's matrix (cm.Tr) is not the identity
+};
+
+// Throws vbrdf::InputError when a face references a deleted vertex or when no vertex has a
+// normal (the message names the mesh and the MeshLab filter that computes normals).
+MeshArrays mesh_arrays(const MeshModel &mesh);
+
+// Every raster of the document with its shot and the path of its first image plane.
+// Throws vbrdf::InputError naming a raster without image.
+std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document);
+
+// The .mlp of the document when it has one, else the mesh file (its folder is used for the
+// default .lp search and output path). May be empty for a mesh never saved.
+std::string project_path(const MeshDocument &document, const MeshModel &mesh);
+
+// Absolute path of `path` (relative paths are taken relative to the project's folder, not to
+// the process's working directory, which meshlabserver changes while loading). "" stays "".
+std::string resolve_path(const std::string &path, const std::string &project_path);
+
+// Sets the mesh's per-vertex colours (enabling the colour attribute) and stores every attribute
+// as a float per-vertex attribute of the same name.
+void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint8_t> &colors_rgba,
+                   const std::vector<vbrdf::VertexAttribute> &attributes);
+
+// Makes MeshLab's plugin GL context current for its lifetime and gives its get-proc-address.
+// Without a context (or if it cannot be made current) get_proc() is empty: CPU visibility.
+class GlContextScope {
+public:
+  GlContextScope(MLPluginGLContext *context, const std::function<void(const std::string &)> &log);
+  ~GlContextScope();
+  GlContextScope(const GlContextScope &) = delete;
+  GlContextScope &operator=(const GlContextScope &) = delete;
+  std::function<void *(const char *)> get_proc() const;
+
+private:
+  MLPluginGLContext *context_ = nullptr;  // non-null only while current
+};
+
+// Maps the core's progress (fraction, stage) onto MeshLab's callback: integer percent, called
+// only when the percent or the stage changes, and only from the filter's own thread (the GUI
+// callback processes Qt events).
+vbrdf::ProgressFn progress_adapter(vcg::CallBackPos *cb, const std::string &prefix);
+
+} // namespace vbrdf_plugin

@@ -1,0 +1,46 @@
+# Build-time script (cmake -P): a private meshlabserver that loads the built plugin.
+#   RUN_DIR/meshlab/meshlabserver      copy of SYSTEM_SERVER (a symlink would resolve to /usr/bin
+#                                      and load only the system plugins)
+#   RUN_DIR/meshlab/plugins/*.so       links to every system plugin, plus PLUGIN_FILE
+#   RUN_DIR/lib/<arch>/meshlab         link to SYSTEM_LIB_DIR: the binary's RUNPATH is
+#                                      $ORIGIN/../lib/<arch>/meshlab
+#   RUN_DIR/run_meshlabserver.sh       wrapper (from WRAPPER_TEMPLATE)
+foreach(var RUN_DIR SYSTEM_SERVER SYSTEM_LIB_DIR PLUGIN_FILE WRAPPER_TEMPLATE)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "setup_meshlab_run.cmake: ${var} not set")
+  endif()
+endforeach()
+if(NOT EXISTS "${SYSTEM_SERVER}")
+  message(FATAL_ERROR "${SYSTEM_SERVER} not found: install Debian's meshlab package")
+endif()
+
+set(server_dir "${RUN_DIR}/meshlab")
+set(plugin_dir "${server_dir}/plugins")
+file(MAKE_DIRECTORY "${plugin_dir}")
+file(COPY "${SYSTEM_SERVER}" DESTINATION "${server_dir}")
+
+# Rebuild the links each time: system plugins may have changed.
+file(GLOB old_links "${plugin_dir}/*")
+if(old_links)
+  file(REMOVE ${old_links})
+endif()
+get_filename_component(our_name "${PLUGIN_FILE}" NAME)
+file(GLOB system_plugins "${SYSTEM_LIB_DIR}/plugins/*.so")
+foreach(p IN LISTS system_plugins)
+  get_filename_component(name "${p}" NAME)
+  if(NOT name STREQUAL our_name)  # an installed copy of ours must not shadow the build's
+    file(CREATE_LINK "${p}" "${plugin_dir}/${name}" SYMBOLIC)
+  endif()
+endforeach()
+file(CREATE_LINK "${PLUGIN_FILE}" "${plugin_dir}/${our_name}" SYMBOLIC)
+
+# Recreate the relative library path of the binary's RUNPATH.
+get_filename_component(lib_parent "${SYSTEM_LIB_DIR}" DIRECTORY)   # /usr/lib/<arch>
+get_filename_component(arch "${lib_parent}" NAME)
+file(MAKE_DIRECTORY "${RUN_DIR}/lib/${arch}")
+if(NOT EXISTS "${RUN_DIR}/lib/${arch}/meshlab")
+  file(CREATE_LINK "${SYSTEM_LIB_DIR}" "${RUN_DIR}/lib/${arch}/meshlab" SYMBOLIC)
+endif()
+
+configure_file("${WRAPPER_TEMPLATE}" "${RUN_DIR}/run_meshlabserver.sh" @ONLY)
+execute_process(COMMAND chmod 755 "${RUN_DIR}/run_meshlabserver.sh")

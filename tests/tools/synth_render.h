@@ -1,0 +1,65 @@
+#pragma once
+// CPU renderer of the synthetic captures: z-buffer rasterisation through a vcg::Shot (supersampled,
+// perspective-correct interpolation of per-vertex attributes), Phong shading, cast shadows by
+// exact ray casts, PNG encoding (8-bit sRGB or 16-bit linear).
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "synth_bvh.h"
+#include "synth_camera.h"
+#include "synth_scene.h"
+
+namespace synth {
+
+struct ShadeSettings {
+  float irradiance = 1.0f;  // E, white directional light
+  bool linear16 = false;    // 16-bit linear PNG instead of 8-bit sRGB
+  float noise_sigma = 0;    // Gaussian noise std-dev in linear units (0..1 = full scale)
+  uint64_t seed = 1;        // noise seed
+};
+
+// The model, per colour channel, without the visibility factor:
+//   E * (kd * max(N.L, 0) * C + ks * max(R.V, 0)^shininess),  R = 2 (N.L) N - L
+// N unit normal, L unit direction towards the light, V unit direction towards the camera centre.
+V3 phong(float kd, float ks, float shininess, V3 color, V3 N, V3 L, V3 V, float irradiance);
+
+// Scene-wide data shared by all photos.
+struct RenderContext {
+  RenderContext(const Scene &scene);
+  const Scene &scene;
+  Bvh bvh;
+  std::vector<V3> face_normal;  // geometric normals (unit, outwards)
+  float ray_eps;                // shadow-ray origin offset along the normal (world units)
+
+  // 1 when N.L > 0, the geometric normal faces the light and the ray towards it is free.
+  bool lit(V3 p, V3 geometric_normal, V3 shading_normal, V3 L) const;
+};
+
+// Visible surface per sample of one view (ss x ss samples per pixel, box-filtered by
+// render_photo): triangle id (-1 = background) and perspective-correct barycentrics of
+// vertices 1 and 2.
+struct ViewRaster {
+  int width = 0, height = 0, ss = 1;
+  std::vector<int32_t> tri;
+  std::vector<float> b1, b2;
+};
+ViewRaster rasterize(const RenderContext &ctx, const Shot &shot, int ss);
+
+struct PhotoStats {
+  uint64_t covered_pixels = 0;    // pixels with at least one object sample
+  uint64_t saturated_pixels = 0;  // covered pixels with a clipped channel
+};
+
+// One photo under a directional light (world direction towards the light), BGR, CV_8UC3 or
+// CV_16UC3. `photo_key` decorrelates the noise of different photos.
+cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &raster, const Shot &shot,
+                     V3 light_world, const ShadeSettings &settings, uint64_t photo_key,
+                     PhotoStats &stats);
+
+// Encodings (value clipped to [0, 1] first).
+uint8_t encode_srgb8(float linear);
+uint16_t encode_linear16(float linear);
+
+} // namespace synth
