@@ -1,0 +1,77 @@
+// bench_gather: time of sample gathering (visibility depth passes + pixel samples + diffuse
+// colour) on a project, for the GL back end (OSMesa llvmpipe) and the CPU ray caster, using the
+// first P photos. Prints one CSV line per run:
+//   backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples
+//   bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header]
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "diffuse_color.h"
+#include "light_file.h"
+#include "mesh_io.h"
+#include "osmesa_context.h"
+#include "pipeline.h"
+#include "project.h"
+#include "visibility_gl.h"
+
+using namespace vbrdf;
+
+namespace {
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+std::vector<int> parse_list(const std::string &s) {
+  std::vector<int> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
+  return out;
+}
+} // namespace
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header]\n");
+    return 2;
+  }
+  std::string backend = "both";
+  std::vector<int> photo_counts;
+  bool header = false;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--backend" && i + 1 < argc) backend = argv[++i];
+    else if (a == "--photos" && i + 1 < argc) photo_counts = parse_list(argv[++i]);
+    else if (a == "--csv-header") header = true;
+  }
+  const Project project = read_project(argv[1]);
+  const MeshData mesh = load_mesh_ply(project.mesh_path);
+  const auto all_lights = resolve_light_directions(project.rasters, find_default_light_file(project.project_path, ""));
+  if (photo_counts.empty()) photo_counts.push_back(int(project.rasters.size()));
+  test::OsMesaContext context;
+  if (header) std::printf("backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples\n");
+  for (const std::string b : {std::string("gl"), std::string("cpu")}) {
+    if (backend != "both" && backend != b) continue;
+    for (int count : photo_counts) {
+      const size_t p = std::min(size_t(count), project.rasters.size());
+      std::vector<Raster> rasters(project.rasters.begin(), project.rasters.begin() + long(p));
+      std::vector<std::array<float, 3>> lights(all_lights.begin(), all_lights.begin() + long(p));
+      const double t0 = now();
+      auto vis = b == "gl" ? make_gl_visibility(mesh.view(), context.get_proc_address(), VisibilitySettings())
+                           : make_cpu_visibility(mesh.view(), VisibilitySettings());
+      const VisibilityMasks masks = compute_visibility(mesh.view(), rasters, lights, *vis);
+      const double t1 = now();
+      GatherSettings gs;
+      PhotoCache cache(gs.encoding, gs.saturation_level, gs.photo_cache_bytes);
+      std::vector<DiffuseEstimate> est(mesh.positions.size() / 3);
+      const GatherStats stats = gather_samples(mesh.view(), rasters, lights, masks, gs, cache, [&](const SampleChunk &c) {
+        estimate_diffuse_chunk(c, &est[c.first_vertex]);
+      });
+      const double t2 = now();
+      std::printf("%s,%zu,%zu,%d,%d,%.3f,%.3f,%.3f,%llu\n", b.c_str(), mesh.positions.size() / 3, p, rasters[0].width(),
+                  rasters[0].height(), t1 - t0, t2 - t1, t2 - t0, (unsigned long long)stats.stored);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
