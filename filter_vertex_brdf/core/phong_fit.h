@@ -9,7 +9,8 @@
 //     most `specular_weight_cap` times the weight of the other samples (diffuse-hole remedy 1),
 //     prior = diffuse_prior * W * sum_c (rho_c - rho0_c)^2, rho = k_d C, rho0 the diffuse-only
 //     estimate, W the total weight (remedy 2: a weak pull towards the diffuse-only fit).
-// Usable samples: lit (no shadow flag), unsaturated, N.L > 0. Highlight samples: R.E > T_s.
+// Usable samples: lit (no shadow flag), unsaturated, clean pixel (no kMixedPixel), N.L > 0, and
+// not grazing (kGrazing) unless a highlight. Highlight samples: R.E > T_s.
 //
 // Method (variable projection of the thesis's 4.6 cycle): for fixed alpha the model is linear in
 // (rho_r, rho_g, rho_b, k_s), so the "(k_d, k_s)" and "colour" stages are solved exactly and
@@ -75,6 +76,13 @@ void fit_vertex_cpu(const Sample *samples, size_t count, const PhongFitOptions &
 
 // Fits every vertex of a chunk (OpenMP). `out` has chunk.vertex_count entries.
 void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out);
+
+// Sets a diffuse-only result (k_s = 0) with diffuse reflectance rho = k_d C (normalised as above)
+// and recomputes DQ, SQ and RMSE from the vertex's samples. The pipeline uses it to give
+// diffuse-only vertices the robust basic colour estimate (diffuse_color.h) instead of the plain
+// weighted mean of the fit.
+void set_diffuse_only_reflectance(const Sample *samples, size_t count, const PhongFitOptions &options,
+                                  const float rho[3], VertexFit &out);
 
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
 void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float out_rgb[3]);

@@ -123,8 +123,7 @@ double alpha_from_highlights(const std::vector<FitSample> &samples, const double
     sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly, ++n;
   }
   const double var = sxx - sx * sx / std::max(n, 1);
-  if (n < 2 || var < 1e-10) return o.alpha_init;
-  const double slope = (sxy - sx * sy / n) / var;
+  const double slope = (n < 2 || var < 1e-10) ? double(o.alpha_init) : (sxy - sx * sy / n) / var;
   return std::min(std::max(slope, double(o.alpha_min)), double(o.alpha_max));
 }
 
@@ -173,7 +172,7 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
   out.kd = float(kd);
   for (int c = 0; c < 3; ++c) out.color[c] = kd > 0 ? float(std::min(1.0, L.rho[c] / kd)) : 0.0f;
   out.ks = float(L.ks);
-  out.shininess = L.ks > 0 ? float(alpha) : 0.0f;
+  out.shininess = out.ks > 0 ? float(alpha) : 0.0f;  // decided on the stored (float) k_s
 }
 
 } // namespace
@@ -184,16 +183,22 @@ void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float ou
   for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
 }
 
-void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
-  set_sentinels(out);
-  std::vector<FitSample> samples;
+namespace {
+// The fit's usable samples (see phong_fit.h); returns the number of highlight samples.
+int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std::vector<FitSample> &samples,
+                   double &w_high, double &w_other) {
+  samples.clear();
   samples.reserve(count);
-  double w_high = 0, w_other = 0;
+  w_high = w_other = 0;
   int n_high = 0;
   for (size_t i = 0; i < count; ++i) {
     const Sample &s = in[i];
     if ((s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) || !(s.n_dot_l > 0)) continue;
-    if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.r_dot_e))
+    // Grazing light (N.L < T_d) is as unreliable for the fit as for the basic colour (normal
+    // errors, shading-model breakdown); a grazing highlight is still specular evidence.
+    if ((s.flags & kGrazing) && !(s.flags & kHighlight)) continue;
+    if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.r_dot_e) ||
+        !std::isfinite(s.n_dot_l))
       continue;  // a corrupt sample is not evidence
     FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.r_dot_e, s.n_dot_l,
                 s.r_dot_e > o.specular_threshold};
@@ -201,6 +206,27 @@ void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, Ve
     n_high += x.highlight;
     samples.push_back(x);
   }
+  return n_high;
+}
+} // namespace
+
+void set_diffuse_only_reflectance(const Sample *in, size_t count, const PhongFitOptions &o, const float rho[3],
+                                  VertexFit &out) {
+  std::vector<FitSample> samples;
+  double w_high, w_other;
+  usable_samples(in, count, o, samples, w_high, w_other);
+  Linear L;
+  for (int c = 0; c < 3; ++c) L.rho[c] = std::min(std::max(double(rho[c]), 0.0), double(o.kd_max));
+  store_linear(L, 0, out);
+  out.status = kFitDiffuseOnly;
+  quality_metrics(samples, out, out);
+}
+
+void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
+  set_sentinels(out);
+  std::vector<FitSample> samples;
+  double w_high, w_other;
+  const int n_high = usable_samples(in, count, o, samples, w_high, w_other);
   if (samples.empty()) return;
   // Remedy 1: highlight samples may not outweigh the rest.
   if (w_other > 0 && w_high > o.specular_weight_cap * w_other) {
@@ -229,6 +255,9 @@ void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, Ve
     if (alt.energy < best.energy) best = alt, alpha = alpha_h;
   }
 
+  // Scale of the data (objective of the zero model): floors below are relative to it, so that
+  // the stopping rule does not depend on the photos' absolute brightness.
+  const double data_energy = problem.energy(Linear(), alpha) + 1e-300;
   int it = 0;
   bool converged = !ks_free;
   double damping = 1e-3;
@@ -243,11 +272,12 @@ void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, Ve
     problem.derivatives(best, alpha, grad, curv);
     bool improved = false;
     for (int attempt = 0; attempt < 6 && !improved; ++attempt) {
-      const double t = std::min(std::max(std::log(alpha) - grad / (curv * (1 + damping) + 1e-30), t_min), t_max);
+      const double t =
+          std::min(std::max(std::log(alpha) - grad / (curv * (1 + damping) + 1e-30 * data_energy), t_min), t_max);
       const double trial_alpha = std::exp(t);
       const Linear trial = problem.solve(trial_alpha, true, o);
       if (trial.energy < best.energy) {
-        const double gain = (best.energy - trial.energy) / std::max(best.energy, 1e-30);
+        const double gain = (best.energy - trial.energy) / std::max(best.energy, 1e-14 * data_energy);
         best = trial, alpha = trial_alpha, improved = true, damping = std::max(damping / 3, 1e-7);
         if (gain < o.tolerance) converged = true;
       } else {

@@ -8,6 +8,7 @@
 #include "file_util.h"
 #include "light_file.h"
 #include "output_ply.h"
+#include "phong_fit_gpu.h"
 #include "visibility_gl.h"
 
 namespace vbrdf {
@@ -112,12 +113,175 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
   return cpu;
 }
 
-FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
-                  const ProgressFn &progress, const LogFn &log) {
+namespace {
+class CpuFitter : public PhongFitter {
+public:
+  const char *name() const override { return "CPU (double, OpenMP)"; }
+  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
+    fit_chunk_cpu(chunk, o, out);
+  }
+};
+
+class GpuFitter : public PhongFitter {
+public:
+  explicit GpuFitter(const GetProcAddressFn &get_proc) : gpu_(get_proc), name_("GPU compute shader, " + gpu_.device()) {}
+  const char *name() const override { return name_.c_str(); }
+  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
+    gpu_.fit_chunk(chunk, o, out);
+  }
+
+private:
+  PhongFitGpu gpu_;
+  std::string name_;
+};
+
+// Everything the chunk consumer produces, per vertex.
+void consume_chunk(const SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options, FitResult &r,
+                   double &fit_seconds) {
+  estimate_diffuse_chunk(chunk, &r.diffuse[chunk.first_vertex]);
+  if (!fitter) return;
+  const auto t = Clock::now();
+  fitter->fit_chunk(chunk, options, &r.fits[chunk.first_vertex]);
+  // Diffuse-only vertices take the robust basic colour (outlier rejection) when it is clean.
+  for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
+    VertexFit &f = r.fits[chunk.first_vertex + i];
+    const DiffuseEstimate &e = r.diffuse[chunk.first_vertex + i];
+    if (f.status == kFitDiffuseOnly && e.valid && !e.from_mixed_pixels)
+      set_diffuse_only_reflectance(chunk.samples.data() + chunk.offsets[i], chunk.offsets[i + 1] - chunk.offsets[i],
+                                   options, e.rgb, f);
+  }
+  fit_seconds += seconds_since(t);
+}
+
+// Linear diffuse reflectance shown and written: the fitted k_d C where the Phong fit has samples,
+// else the basic estimate (mixed-pixel fallback included), else nothing.
+bool displayed_reflectance(const FitResult &r, size_t v, float rho[3]) {
+  if (!r.fits.empty() && r.fits[v].status != kFitNone) {
+    for (int c = 0; c < 3; ++c) rho[c] = r.fits[v].kd * r.fits[v].color[c];
+    return true;
+  }
+  for (int c = 0; c < 3; ++c) rho[c] = r.diffuse[v].valid ? r.diffuse[v].rgb[c] : 0.0f;
+  return r.diffuse[v].valid;
+}
+
+void build_outputs(const FitInput &input, const FitSettings &settings, FitResult &r) {
+  const size_t n = input.mesh.vertex_count;
+  r.colors_rgba.assign(4 * n, 0);
+  r.quality.assign(n, 0.0f);
+  std::vector<std::string> names = {"diffuse_r", "diffuse_g", "diffuse_b", "n_visible", "n_diffuse", "n_specular", "coloured"};
+  if (!r.fits.empty())
+    for (const char *name : {"kd", "ks", "shininess", "color_r", "color_g", "color_b", "dq", "sq", "fit_rmse",
+                             "fit_status", "fit_iterations"})
+      names.push_back(name);
+  for (const std::string &name : names) r.attributes.push_back({name, std::vector<float>(n, 0.0f)});
+  auto attr = [&r](size_t i) -> std::vector<float> & { return r.attributes[i].values; };
+  for (size_t v = 0; v < n; ++v) {
+    const DiffuseEstimate &e = r.diffuse[v];
+    float rho[3];
+    const bool coloured = displayed_reflectance(r, v, rho);
+    for (int c = 0; c < 3; ++c) attr(size_t(c))[v] = rho[c];
+    attr(3)[v] = e.n_seen, attr(4)[v] = e.n_diffuse, attr(5)[v] = e.n_specular;
+    const bool mixed = e.from_mixed_pixels && (r.fits.empty() || r.fits[v].status == kFitNone);
+    attr(6)[v] = coloured ? (mixed ? 2.0f : 1.0f) : 0.0f;
+    if (!r.fits.empty()) {
+      const VertexFit &f = r.fits[v];
+      const float values[] = {f.kd, f.ks, f.shininess, f.color[0], f.color[1], f.color[2], f.dq, f.sq, f.rmse,
+                              float(f.status), float(f.iterations)};
+      for (size_t k = 0; k < 11; ++k) attr(7 + k)[v] = values[k];
+      r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
+      r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
+      r.fit_converged += f.status == kFitFull && f.converged, r.fit_iterations += f.iterations;
+    }
+    if (coloured) {
+      for (int c = 0; c < 3; ++c) r.colors_rgba[4 * v + size_t(c)] = srgb_byte(rho[c]);
+      r.colors_rgba[4 * v + 3] = 255;
+      ++r.vertices_coloured;
+      r.vertices_from_mixed += mixed;
+    } else {
+      // Never silently painted: the input colour stays (MeshLab's default white when none).
+      for (int c = 0; c < 4; ++c)
+        r.colors_rgba[4 * v + size_t(c)] = input.mesh_colors.size() == 4 * n ? input.mesh_colors[4 * v + size_t(c)] : 255;
+      if (e.n_seen == 0) ++r.vertices_unseen; else ++r.vertices_no_diffuse;
+    }
+  }
+}
+
+std::string build_report(const FitInput &input, const FitSettings &settings, const FitResult &r) {
+  const MeshView &mesh = input.mesh;
+  const size_t n = mesh.vertex_count;
+  const GatherStats &g = r.gather;
+  std::ostringstream rep;
+  rep << "filter_vertex_brdf report\n"
+      << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
+      << "photos: " << input.rasters.size() << ", lights: " << r.light_file << "\n"
+      << "visibility back end: " << r.visibility_backend << "\n"
+      << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
+      << ", T_d (N.L) = " << settings.gather.diffuse_threshold << "\n"
+      << "vertices coloured: " << r.vertices_coloured << " (" << percent(r.vertices_coloured, n) << ")\n"
+      << "  of which from mixed pixels only (silhouette/border/contact; coloured = 2): " << r.vertices_from_mixed << "\n"
+      << "vertices seen but without a usable sample (kept their colour): " << r.vertices_no_diffuse << "\n"
+      << "vertices seen by no photo (skipped, kept their colour; need another viewpoint): " << r.vertices_unseen << "\n"
+      << "vertex-photo pairs: " << g.pairs << ", samples stored (seen): " << g.stored << "\n";
+  const std::pair<uint16_t, const char *> flag_names[] = {
+      {kOffImage, "off image / behind camera"}, {kBackFacing, "back-facing"}, {kOccluded, "occluded"},
+      {kAttachedShadow, "facing away from the light"}, {kCastShadow, "in cast shadow"},
+      {kSaturated, "saturated (not used)"}, {kMixedPixel, "mixed pixel at a silhouette/border (not used)"},
+      {kGrazing, "grazing light (N.L < T_d)"}, {kHighlight, "highlight (R.E > T_s)"}};
+  for (const auto &f : flag_names)
+    rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
+  for (size_t i = 0; i < input.rasters.size(); ++i)
+    if (g.raster_seen_vertices[i] == 0)
+      rep << "skipped: raster '" << input.rasters[i].label << "' sees no vertex (check its registration); its photo was not read\n";
+  if (!r.fits.empty()) {
+    rep << "Phong fit back end: " << r.fit_backend << "\n"
+        << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
+        << "  diffuse-only (k_s = 0; k_s/alpha stages skipped: fewer than " << settings.phong.min_specular_samples
+        << " clean highlight samples or no specular term): " << r.fit_diffuse_only << "\n"
+        << "  no usable sample (sentinels: k_d = k_s = shininess = 0): " << r.fit_none << "\n"
+        << "  converged before the cap of " << settings.phong.max_iterations << " iterations: " << r.fit_converged
+        << " of " << r.fit_full << " full fits; alpha iterations run: " << r.fit_iterations << " of at most "
+        << uint64_t(r.fit_full + r.fit_diffuse_only) * uint64_t(std::max(0, settings.phong.max_iterations)) << "\n";
+  } else {
+    rep << "Phong fit: off (basic diffuse colour only)\n";
+  }
+  rep << "time: visibility " << fixed(r.seconds_visibility) << " s, samples " << fixed(r.seconds_gather - r.seconds_fit)
+      << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
+      << g.rasters_skipped << " raster x chunk pairs skipped)\n";
+  return rep.str();
+}
+} // namespace
+
+std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
+                                               const std::function<void *(const char *)> &get_proc, const LogFn &log) {
+  if (settings.fit_backend != FitBackendChoice::CPU) {
+    if (get_proc) {
+      try {
+        std::unique_ptr<PhongFitter> gpu(new GpuFitter(get_proc));
+        log(std::string("Phong fit: ") + gpu->name() + ".");
+        return gpu;
+      } catch (const ProcessingError &e) {
+        if (settings.fit_backend == FitBackendChoice::GPU) throw;
+        log(std::string("Phong fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");
+      }
+    } else if (settings.fit_backend == FitBackendChoice::GPU) {
+      throw ProcessingError("The GPU fit back end was requested but no GL context is available.");
+    }
+  }
+  std::unique_ptr<PhongFitter> cpu(new CpuFitter());
+  log(std::string("Phong fit: ") + cpu->name() + ".");
+  return cpu;
+}
+
+FitResult run_fit(const FitInput &input, const FitSettings &settings_in, VisibilityBackend &visibility,
+                  PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {
   validate_input(input);
+  FitSettings settings = settings_in;
+  settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
+  if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
   const MeshView &mesh = input.mesh;
   FitResult result;
   result.visibility_backend = visibility.name();
+  result.fit_backend = settings.fit_reflectance ? fitter->name() : "";
 
   result.light_file = settings.light_file.empty()
                           ? find_default_light_file(input.project_path, input.rasters.front().image_path)
@@ -144,69 +308,19 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings, Visibility
 
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
-  const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.5f * f, s); };
+  if (settings.fit_reflectance) result.fits.resize(mesh.vertex_count);
+  const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
   result.gather = gather_samples(
       mesh, input.rasters, lights, masks, settings.gather, photos,
-      [&](const SampleChunk &chunk) { estimate_diffuse_chunk(chunk, &result.diffuse[chunk.first_vertex]); },
+      [&](const SampleChunk &chunk) {
+        consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
+      },
       gather_progress);
   result.seconds_gather = seconds_since(t);
 
-  // Outputs: colour where estimated, input colour elsewhere (never silently painted).
   t = Clock::now();
-  const size_t n = mesh.vertex_count;
-  result.colors_rgba.resize(4 * n);
-  const char *names[] = {"diffuse_r", "diffuse_g", "diffuse_b", "n_visible", "n_diffuse", "n_specular", "coloured"};
-  for (const char *name : names) result.attributes.push_back({name, std::vector<float>(n, 0.0f)});
-  for (size_t v = 0; v < n; ++v) {
-    const DiffuseEstimate &e = result.diffuse[v];
-    for (int c = 0; c < 3; ++c) result.attributes[size_t(c)].values[v] = e.valid ? e.rgb[c] : 0.0f;
-    result.attributes[3].values[v] = e.n_seen;
-    result.attributes[4].values[v] = e.n_diffuse;
-    result.attributes[5].values[v] = e.n_specular;
-    result.attributes[6].values[v] = e.valid ? (e.from_mixed_pixels ? 2.0f : 1.0f) : 0.0f;
-    if (e.valid && e.from_mixed_pixels) ++result.vertices_from_mixed;
-    if (e.valid) {
-      for (int c = 0; c < 3; ++c) result.colors_rgba[4 * v + size_t(c)] = srgb_byte(e.rgb[c]);
-      result.colors_rgba[4 * v + 3] = 255;
-      ++result.vertices_coloured;
-    } else {
-      for (int c = 0; c < 4; ++c)
-        result.colors_rgba[4 * v + size_t(c)] =
-            input.mesh_colors.size() == 4 * n ? input.mesh_colors[4 * v + size_t(c)] : uint8_t(255);  // MeshLab default: white
-      if (e.n_seen == 0) ++result.vertices_unseen; else ++result.vertices_no_diffuse;
-    }
-  }
-
-  // Report.
-  const GatherStats &g = result.gather;
-  std::ostringstream rep;
-  rep << "filter_vertex_brdf report\n"
-      << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
-      << "photos: " << input.rasters.size() << ", lights: " << result.light_file << "\n"
-      << "visibility back end: " << result.visibility_backend << "\n"
-      << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
-      << ", T_d (N.L) = " << settings.gather.diffuse_threshold << "\n"
-      << "vertices coloured: " << result.vertices_coloured << " (" << percent(result.vertices_coloured, n) << ")\n"
-      << "  of which from mixed pixels only (silhouette/border/contact; coloured = 2): " << result.vertices_from_mixed << "\n"
-      << "vertices seen but without a diffuse sample (kept their colour): " << result.vertices_no_diffuse << "\n"
-      << "vertices seen by no photo (kept their colour; need another viewpoint): " << result.vertices_unseen << "\n"
-      << "vertex-photo pairs: " << g.pairs << ", samples stored (seen): " << g.stored << "\n";
-  const std::pair<uint16_t, const char *> flag_names[] = {
-      {kOffImage, "off image / behind camera"}, {kBackFacing, "back-facing"}, {kOccluded, "occluded"},
-      {kAttachedShadow, "facing away from the light"}, {kCastShadow, "in cast shadow"},
-      {kSaturated, "saturated (not used)"}, {kMixedPixel, "mixed pixel at a silhouette/border (not used)"}, {kGrazing, "grazing light (N.L < T_d)"}, {kHighlight, "highlight (R.E > T_s)"}};
-  for (const auto &f : flag_names)
-    rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
-  size_t blind = 0;
-  for (size_t r = 0; r < input.rasters.size(); ++r)
-    if (g.raster_seen_vertices[r] == 0) {
-      ++blind;
-      rep << "warning: raster '" << input.rasters[r].label << "' sees no vertex (check its registration)\n";
-    }
-  rep << "time: visibility " << fixed(result.seconds_visibility) << " s, samples + colour " << fixed(result.seconds_gather)
-      << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes)\n";
-  result.report = rep.str();
-
+  build_outputs(input, settings, result);
+  result.report = build_report(input, settings, result);
   write_result_ply(result.output_ply, mesh, result.colors_rgba, result.attributes);
   result.seconds_output = seconds_since(t);
   result.report += "output: " + result.output_ply + " (written in " + fixed(result.seconds_output) + " s)\n";
@@ -214,7 +328,6 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings, Visibility
 
   std::istringstream lines(result.report);
   for (std::string line; std::getline(lines, line);) log(line);
-  if (blind) log(std::to_string(blind) + " raster(s) see no vertex and were skipped.");
   if (progress) progress(1.0f, "done");
   return result;
 }

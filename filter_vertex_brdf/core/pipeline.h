@@ -1,6 +1,6 @@
 #pragma once
 // The whole filter without MeshLab: project -> lights -> visibility -> samples -> diffuse colour
-// -> outputs. The plugin and the command-line tool both call this; they only differ in how they
+// and Phong fit (per vertex chunk) -> outputs. The plugin and the command-line tool both call this; they only differ in how they
 // obtain the mesh, the rasters and the GL context.
 #include <array>
 #include <functional>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "diffuse_color.h"
+#include "phong_fit.h"
 #include "mesh_view.h"
 #include "output_ply.h"
 #include "samples.h"
@@ -19,11 +20,17 @@ namespace vbrdf {
 using LogFn = std::function<void(const std::string &line)>;
 
 enum class VisibilityChoice { Auto = 0, GL = 1, CPU = 2 };
+enum class FitBackendChoice { Auto = 0, GPU = 1, CPU = 2 };
+enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
 
 struct FitSettings {
   GatherSettings gather;
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;
+  bool fit_reflectance = true;         // false: basic diffuse colour only (no k_d/k_s/alpha)
+  PhongFitOptions phong;               // its specular_threshold is taken from gather
+  FitBackendChoice fit_backend = FitBackendChoice::Auto;
+  QualityOutput quality = QualityOutput::DQ;  // what goes into vertex quality
   std::string light_file;   // "" = search beside the project, then beside the images
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
 };
@@ -50,10 +57,15 @@ void validate_input(const FitInput &input);
 
 struct FitResult {
   std::vector<DiffuseEstimate> diffuse;   // per vertex
+  std::vector<VertexFit> fits;            // per vertex (empty when fit_reflectance is off)
+  std::vector<float> quality;             // per vertex, as chosen by FitSettings::quality
   std::vector<uint8_t> colors_rgba;       // display colours: sRGB of rho where valid, else the input colour
   std::vector<VertexAttribute> attributes;// what goes into the PLY
   GatherStats gather;
   std::string visibility_backend;         // name of the back end that ran
+  std::string fit_backend;                // name of the fit back end ("" when not fitted)
+  size_t fit_full = 0, fit_diffuse_only = 0, fit_none = 0, fit_converged = 0, fit_iterations = 0;
+  double seconds_fit = 0;
   std::string light_file;                 // the .lp used
   std::string output_ply;                 // where the PLY was written
   std::string report;                     // human-readable report (also written beside the PLY)
@@ -67,10 +79,24 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
                                                            const std::function<void *(const char *)> &get_proc,
                                                            const LogFn &log);
 
-// Runs the pipeline and writes the PLY and the report (<ply>.report.txt). Nothing is written
-// if any stage fails. Throws InputError / ProcessingError.
+// The per-vertex Phong fit back end (phong_fit.h): GPU compute shader or CPU reference.
+class PhongFitter {
+public:
+  virtual ~PhongFitter() = default;
+  virtual const char *name() const = 0;
+  virtual void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out) = 0;
+};
+
+// GPU when `get_proc` is given and the context has compute shaders (unless CPU is forced),
+// else CPU. Logs which one runs and why. The GL context must stay current while it is used.
+std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
+                                               const std::function<void *(const char *)> &get_proc, const LogFn &log);
+
+// Runs the pipeline and writes the PLY and the report (<ply stem>_report.txt). Nothing is
+// written if any stage fails. `fitter` may be null when settings.fit_reflectance is false.
+// Throws InputError / ProcessingError.
 FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
-                  const ProgressFn &progress, const LogFn &log);
+                  PhongFitter *fitter, const ProgressFn &progress, const LogFn &log);
 
 // Default output path for a project: <folder>/<name>_brdf.ply ("vertex_brdf.ply" in the
 // current folder when no project path is known).

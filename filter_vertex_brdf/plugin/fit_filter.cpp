@@ -21,6 +21,12 @@ const char *const kVisibilityBackend = "visibilityBackend";
 const char *const kDepthTolerance = "depthTolerance";
 const char *const kShadowMapSize = "shadowMapSize";
 const char *const kMemoryBudgetMB = "memoryBudgetMB";
+const char *const kFitReflectance = "fitReflectance";
+const char *const kFitBackend = "fitBackend";
+const char *const kInitialShininess = "initialShininess";
+const char *const kMaxIterations = "maxIterations";
+const char *const kMinSpecularSamples = "minSpecularSamples";
+const char *const kQualityOutput = "qualityOutput";
 
 void require(bool ok, const char *param, const std::string &what) {
   if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
@@ -31,19 +37,23 @@ void require(bool ok, const char *param, const std::string &what) {
 QString FitFilter::name() const { return "Vertex BRDF: fit per-vertex reflectance"; }
 
 QString FitFilter::info() const {
-  return "Estimates the diffuse reflectance (albedo) of every vertex from the registered photos of the "
-         "project (the raster layers), each taken from a fixed camera under a different, known light "
-         "direction (an RTI/photometric-stereo capture).<br><br>"
+  return "Fits a Phong reflectance model (colour C, diffuse k<sub>d</sub>, specular k<sub>s</sub>, "
+         "shininess &alpha;) to every vertex from the registered photos of the project (the raster layers), "
+         "each taken under a different, known light direction (an RTI/photometric-stereo capture; several "
+         "viewpoints may be mixed).<br><br>"
          "Light directions are read from an <i>.lp</i> file (RTIBuilder/Relight format: one line per photo, "
          "<code>image lx ly lz</code>, direction towards the light in the camera frame). For each vertex "
          "and photo the filter tests visibility from the camera and cast shadows from the light (OpenGL "
          "depth passes, or a CPU ray cast), samples the photo, and discards shadowed, grazing "
          "(N&middot;L below the diffuse threshold), specular (R&middot;E above the specular threshold) and "
-         "saturated samples. The albedo is the least-squares fit of the remaining samples to a Lambertian "
-         "model.<br><br>"
+         "saturated samples for a first diffuse colour, then fits f = k<sub>d</sub> (N&middot;L) C + "
+         "k<sub>s</sub> (R&middot;E)<sup>&alpha;</sup> to all lit, unsaturated samples (weighted by N&middot;L; "
+         "on the GPU with a compute shader when MeshLab's OpenGL context allows, else on the CPU). Vertices "
+         "with too little specular evidence get a diffuse-only fit (k<sub>s</sub> = 0).<br><br>"
          "Results: vertex colours become the fitted albedo (sRGB; vertices no photo sees keep their "
-         "colour), the per-vertex values are stored as float attributes (diffuse_r/g/b, n_visible, "
-         "n_diffuse, n_specular, coloured, ...) and written with the geometry to a PLY, plus a text "
+         "colour), vertex quality the chosen fit quality, the per-vertex values are stored as float "
+         "attributes (kd, ks, shininess, color_r/g/b, dq, sq, fit_rmse, diffuse_r/g/b = k<sub>d</sub> C, "
+         "n_visible, n_diffuse, n_specular, coloured, ...) and written with the geometry to a PLY, plus a text "
          "report beside it. The mesh geometry is not changed. The mesh needs per-vertex normals; photos "
          "must be undistorted.<br><br>"
          "Reflectance is known up to one global scale (unknown light intensity and exposure).";
@@ -53,11 +63,11 @@ MeshFilterInterface::FilterClass FitFilter::filterClass() const {
   return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::VertexColoring);
 }
 
-int FitFilter::requirements() const { return MeshModel::MM_VERTCOLOR; }
+int FitFilter::requirements() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY; }
 
 int FitFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
 
-int FitFilter::postConditions() const { return MeshModel::MM_VERTCOLOR; }
+int FitFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY; }
 
 void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
   params.addParam(RichOpenFile(
@@ -99,6 +109,30 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   params.addParam(RichInt(kMemoryBudgetMB, 2048, "Photo memory (MB)",
                           "Decoded photos kept in memory at once; photos beyond it are reloaded when "
                           "needed."));
+  params.addParam(RichBool(kFitReflectance, true, "Fit Phong reflectance",
+                           "Fit k_d, k_s, shininess and colour per vertex. Off: only the basic diffuse colour "
+                           "(faster; kd/ks/shininess attributes are not written)."));
+  params.addParam(RichEnum(kFitBackend, 0, QStringList() << "Auto" << "GPU (compute shader)" << "CPU (reference)",
+                           "Fit back end",
+                           "Where the per-vertex fit runs. Auto: a GLSL compute shader in MeshLab's OpenGL "
+                           "context when it supports OpenGL 4.3, else the CPU (double precision). Both give "
+                           "the same result to about 1e-3."));
+  params.addParam(RichFloat(kInitialShininess, 10.0f, "Initial shininess",
+                            "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
+                            "the highlight samples and keeps the better one). Range [1, 2000]."));
+  params.addParam(RichInt(kMaxIterations, 20, "Max iterations",
+                          "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
+                          "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
+  params.addParam(RichInt(kMinSpecularSamples, 2, "Min specular samples",
+                          "Highlight samples (R.E above the specular threshold, lit, unsaturated) a vertex "
+                          "needs before k_s and shininess are fitted; with fewer the vertex gets a "
+                          "diffuse-only fit (k_s = 0). Guards against 'diffuse holes' (k_d ~ 0, huge k_s)."));
+  params.addParam(RichEnum(kQualityOutput, 0, QStringList() << "Diffuse quality (DQ)" << "Specular quality (SQ)"
+                                                             << "Fit RMSE",
+                           "Vertex quality",
+                           "What is stored in vertex quality, for Render > Color > Per Vertex Quality: the "
+                           "thesis's diffuse or specular quality (0..2, higher is better) or the weighted "
+                           "fit RMSE (lower is better)."));
 }
 
 vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
@@ -122,6 +156,16 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(map_size >= 64 && map_size <= 16384, kShadowMapSize, "must be in [64, 16384]");
   const int budget = params.getInt(kMemoryBudgetMB);
   require(budget >= 16, kMemoryBudgetMB, "must be at least 16");
+  const int fit_backend = params.getEnum(kFitBackend);
+  require(fit_backend >= 0 && fit_backend <= 2, kFitBackend, "must be 0 (Auto), 1 (GPU) or 2 (CPU)");
+  const float alpha0 = params.getFloat(kInitialShininess);
+  require(alpha0 >= s.phong.alpha_min && alpha0 <= s.phong.alpha_max, kInitialShininess, "must be in [1, 2000]");
+  const int iterations = params.getInt(kMaxIterations);
+  require(iterations >= 0 && iterations <= 10000, kMaxIterations, "must be in [0, 10000]");
+  const int min_specular = params.getInt(kMinSpecularSamples);
+  require(min_specular >= 1 && min_specular <= 1000, kMinSpecularSamples, "must be in [1, 1000]");
+  const int quality = params.getEnum(kQualityOutput);
+  require(quality >= 0 && quality <= 2, kQualityOutput, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
 
   s.gather.specular_threshold = specular;
   s.gather.diffuse_threshold = diffuse;
@@ -131,6 +175,12 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.visibility_choice = vbrdf::VisibilityChoice(backend);
   s.visibility.depth_tolerance = tolerance;
   s.visibility.shadow_map_size = map_size;
+  s.fit_reflectance = params.getBool(kFitReflectance);
+  s.fit_backend = vbrdf::FitBackendChoice(fit_backend);
+  s.phong.alpha_init = alpha0;
+  s.phong.max_iterations = iterations;
+  s.phong.min_specular_samples = min_specular;
+  s.quality = vbrdf::QualityOutput(quality);
   return s;
 }
 
@@ -161,18 +211,26 @@ void FitFilter::apply(FilterRun &run) const {
   vbrdf::FitResult result;
   {
     // The GL back end needs the context current for its whole life: destroy it inside the scope.
-    GlContextScope gl(settings.visibility_choice == vbrdf::VisibilityChoice::CPU ? nullptr : run.gl_context, log);
-    std::unique_ptr<vbrdf::VisibilityBackend> visibility =
-        vbrdf::make_visibility_backend(input.mesh, settings, gl.get_proc(), log);
-    result = vbrdf::run_fit(input, settings, *visibility, progress_adapter(run.progress, "Vertex BRDF: "), log);
+    const bool gpu_fit = settings.fit_reflectance && settings.fit_backend != vbrdf::FitBackendChoice::CPU;
+    const bool needs_gl = settings.visibility_choice != vbrdf::VisibilityChoice::CPU || gpu_fit;
+    GlContextScope gl(needs_gl ? run.gl_context : nullptr, log);
+    std::unique_ptr<vbrdf::VisibilityBackend> visibility = vbrdf::make_visibility_backend(
+        input.mesh, settings, settings.visibility_choice == vbrdf::VisibilityChoice::CPU ? nullptr : gl.get_proc(), log);
+    std::unique_ptr<vbrdf::PhongFitter> fitter;
+    if (settings.fit_reflectance) fitter = vbrdf::make_phong_fitter(settings, gl.get_proc(), log);
+    result = vbrdf::run_fit(input, settings, *visibility, fitter.get(), progress_adapter(run.progress, "Vertex BRDF: "),
+                            log);
   }
-  store_results(*mesh, arrays, result.colors_rgba, result.attributes);
+  store_results(*mesh, arrays, result.colors_rgba, settings.fit_reflectance ? result.quality : std::vector<float>(),
+                result.attributes);
 
   std::ostringstream summary;
   summary << "Vertex BRDF: " << result.vertices_coloured << " of " << arrays.vertex_index.size()
           << " vertices coloured, " << result.vertices_unseen << " seen by no photo, " << result.vertices_no_diffuse
-          << " seen but without diffuse sample (visibility: " << result.visibility_backend
-          << ", lights: " << result.light_file << "). Wrote " << result.output_ply;
+          << " seen but without usable sample; " << result.fit_full << " full Phong fits, " << result.fit_diffuse_only
+          << " diffuse-only (visibility: " << result.visibility_backend << ", fit: "
+          << (result.fit_backend.empty() ? std::string("off") : result.fit_backend) << ", lights: " << result.light_file
+          << "). Wrote " << result.output_ply;
   log(summary.str());
 }
 

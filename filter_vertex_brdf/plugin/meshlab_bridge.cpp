@@ -114,9 +114,13 @@ std::string resolve_path(const std::string &path, const std::string &project) {
 }
 
 void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint8_t> &colors_rgba,
-                   const std::vector<vbrdf::VertexAttribute> &attributes) {
+                   const std::vector<float> &quality, const std::vector<vbrdf::VertexAttribute> &attributes) {
   CMeshO &cm = mesh.cm;
   const size_t n = arrays.vertex_index.size();
+  if (quality.size() == n) {  // "Colorize by vertex quality" then shows it
+    mesh.updateDataMask(MeshModel::MM_VERTQUALITY);
+    for (size_t i = 0; i < n; ++i) cm.vert[arrays.vertex_index[i]].Q() = quality[i];
+  }
   mesh.updateDataMask(MeshModel::MM_VERTCOLOR);
   if (colors_rgba.size() == 4 * n)
     for (size_t i = 0; i < n; ++i) {

@@ -37,10 +37,11 @@ std::string project_path(const MeshDocument &document, const MeshModel &mesh);
 // the process's working directory, which meshlabserver changes while loading). "" stays "".
 std::string resolve_path(const std::string &path, const std::string &project_path);
 
-// Sets the mesh's per-vertex colours (enabling the colour attribute) and stores every attribute
+// Sets the mesh's per-vertex colours (enabling the colour attribute), its vertex quality when
+// `quality` has one value per vertex (enabling the quality attribute), and stores every attribute
 // as a float per-vertex attribute of the same name.
 void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint8_t> &colors_rgba,
-                   const std::vector<vbrdf::VertexAttribute> &attributes);
+                   const std::vector<float> &quality, const std::vector<vbrdf::VertexAttribute> &attributes);
 
 // Makes MeshLab's plugin GL context current for its lifetime and gives its get-proc-address.
 // Without a context (or if it cannot be made current) get_proc() is empty: CPU visibility.

@@ -1,6 +1,7 @@
 // vbrdf_fit: runs the filter's core pipeline on a .mlp without MeshLab (GL through OSMesa).
 //   vbrdf_fit project.mlp [--lp lights.lp] [--out result.ply] [--visibility auto|gl|cpu]
 //             [--ts 0.9] [--td 0.5] [--encoding auto|srgb|linear] [--shadow-map 2048]
+//             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 // Exit status: 0 success, 2 bad input (message on stderr), 3 processing error.
 #include <cstdio>
 #include <cstring>
@@ -19,7 +20,8 @@ using namespace vbrdf;
 namespace {
 int usage() {
   std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
-               "                 [--encoding auto|srgb|linear] [--shadow-map N]\n";
+               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--fit auto|gpu|cpu|off]\n"
+               "                 [--iterations N] [--alpha0 X] [--min-specular N]\n";
   return 2;
 }
 } // namespace
@@ -36,6 +38,14 @@ int main(int argc, char **argv) {
     else if (a == "--ts") settings.gather.specular_threshold = std::stof(next());
     else if (a == "--td") settings.gather.diffuse_threshold = std::stof(next());
     else if (a == "--shadow-map") settings.visibility.shadow_map_size = std::stoi(next());
+    else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
+    else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());
+    else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
+    else if (a == "--fit") {
+      const std::string v = next();
+      settings.fit_reflectance = v != "off";
+      settings.fit_backend = v == "gpu" ? FitBackendChoice::GPU : v == "cpu" ? FitBackendChoice::CPU : FitBackendChoice::Auto;
+    }
     else if (a == "--visibility") {
       const std::string v = next();
       settings.visibility_choice = v == "gl" ? VisibilityChoice::GL : v == "cpu" ? VisibilityChoice::CPU : VisibilityChoice::Auto;
@@ -60,7 +70,7 @@ int main(int argc, char **argv) {
 
     std::unique_ptr<test::OsMesaContext> gl;
     std::function<void *(const char *)> get_proc;
-    if (settings.visibility_choice != VisibilityChoice::CPU) {
+    if (settings.visibility_choice != VisibilityChoice::CPU || settings.fit_backend != FitBackendChoice::CPU) {
       try {
         gl.reset(new test::OsMesaContext());
         get_proc = gl->get_proc_address();
@@ -68,8 +78,12 @@ int main(int argc, char **argv) {
         log(std::string("OSMesa context unavailable: ") + e.what());
       }
     }
-    auto visibility = make_visibility_backend(input.mesh, settings, get_proc, log);
-    run_fit(input, settings, *visibility, {}, log);
+    auto visibility = make_visibility_backend(input.mesh, settings,
+                                              settings.visibility_choice == VisibilityChoice::CPU ? nullptr : get_proc, log);
+    std::unique_ptr<PhongFitter> fitter;
+    if (settings.fit_reflectance)
+      fitter = make_phong_fitter(settings, settings.fit_backend == FitBackendChoice::CPU ? nullptr : get_proc, log);
+    run_fit(input, settings, *visibility, fitter.get(), {}, log);
     return 0;
   } catch (const InputError &e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -130,7 +130,9 @@ class ScriptTest(unittest.TestCase):
         types = {"lightFile": "RichOpenFile", "outputPly": "RichSaveFile", "specularThreshold": "RichFloat",
                  "diffuseThreshold": "RichFloat", "photoEncoding": "RichEnum", "saturationLevel": "RichFloat",
                  "visibilityBackend": "RichEnum", "depthTolerance": "RichFloat", "shadowMapSize": "RichInt",
-                 "memoryBudgetMB": "RichInt"}
+                 "memoryBudgetMB": "RichInt", "fitReflectance": "RichBool", "fitBackend": "RichEnum",
+                 "initialShininess": "RichFloat", "maxIterations": "RichInt", "minSpecularSamples": "RichInt",
+                 "qualityOutput": "RichEnum"}
         self.assertEqual({n: p.get("type") for n, p in params.items()}, types)
         # Attributes MeshLab's reader needs, or it silently drops the parameter.
         self.assertEqual(params["lightFile"].get("exts_cardinality"), "1")
