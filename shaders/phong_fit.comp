@@ -44,7 +44,8 @@ uniform uint u_vertex_count;  // vertices in this dispatch
 uniform uint u_sample_base;   // offsets[0]: the samples buffer starts at this sample
 uniform float u_alpha_init, u_alpha_min, u_alpha_max, u_tolerance, u_weight_cap, u_prior;
 uniform float u_kd_max, u_ks_max, u_specular_threshold;
-uniform int u_max_iterations, u_min_specular;
+uniform int u_max_iterations, u_min_specular, u_min_lobe;
+uniform float u_lobe_threshold;
 
 const uint kUnusable = 0x13Fu;  // kNotSeen | kShadowed | kSaturated | kMixedPixel (samples.h)
 const uint kStatusDiffuseOnly = 1u, kStatusFull = 2u;
@@ -131,14 +132,15 @@ void kahan_add(inout float sum, inout float comp, float x) {
 // Set-up passes.
 
 // Pass 1: usable and highlight counts, and the magnitudes that fix the scales.
-void count_samples(out int n, out int n_high) {
-  n = 0; n_high = 0;
+void count_samples(out int n, out int n_high, out int n_lobe) {
+  n = 0; n_high = 0; n_lobe = 0;
   float max_p = 0.0, max_w = 0.0;
   for (uint i = g_begin; i < g_end; ++i) {
     Obs x;
     if (!load(i, x)) continue;
     ++n;
     if (x.high) ++n_high;
+    if (x.s > u_lobe_threshold) ++n_lobe;
     max_p = max(max_p, max(abs(x.p.r), max(abs(x.p.g), abs(x.p.b))));
     max_w = max(max_w, x.w);
   }
@@ -345,13 +347,13 @@ void main() {
   g_high_scale = 1.0;
   g_pixel_scale = 1.0; g_inv_pixel_scale = 1.0; g_inv_weight_scale = 1.0;
 
-  int n, n_high;
-  count_samples(n, n_high);
+  int n, n_high, n_lobe;
+  count_samples(n, n_high, n_lobe);
   if (n == 0) {
     fits[v] = sentinel_fit();
     return;
   }
-  const bool ks_free = n_high >= u_min_specular;
+  const bool ks_free = n_high >= u_min_specular || n_lobe >= u_min_lobe;
   setup_linear(n, n_high, ks_free);
 
   const float alpha0 = clamp(u_alpha_init, u_alpha_min, u_alpha_max);

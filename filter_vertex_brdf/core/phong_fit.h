@@ -44,7 +44,9 @@ struct PhongFitOptions {
   float alpha_max = 2000.0f;
   int max_iterations = 20;       // alpha steps (0 = initial estimate only)
   float tolerance = 1e-5f;       // relative objective improvement that counts as converged
-  int min_specular_samples = 2;  // fewer highlight samples => diffuse-only fit
+  int min_specular_samples = 2;  // k_s and alpha are free with this many highlight samples (R.E > T_s)
+  float lobe_threshold = 0.5f;   // ... or with min_lobe_samples samples with R.E above this
+  int min_lobe_samples = 4;      //     (broad lobes show their energy below T_s)
   float specular_weight_cap = 1.0f;
   float diffuse_prior = 0.02f;
   float kd_max = 16.0f;

@@ -234,7 +234,9 @@ void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, Ve
     for (FitSample &x : samples)
       if (x.highlight) x.w *= scale;
   }
-  const bool ks_free = n_high >= o.min_specular_samples;
+  int n_lobe = 0;
+  for (const FitSample &x : samples) n_lobe += x.s > o.lobe_threshold;
+  const bool ks_free = n_high >= o.min_specular_samples || n_lobe >= o.min_lobe_samples;
   // Remedy 3: too little specular evidence to free k_s and alpha: the few highlight samples
   // cannot be explained by a diffuse-only model, so they are left out (if anything else remains).
   if (!ks_free && n_high > 0 && size_t(n_high) < samples.size())

@@ -44,7 +44,7 @@ std::string phong_fit_source() { return shaders::phong_fit_comp; }
 struct Uniforms {
   GLint vertex_count = -1, sample_base = -1, alpha_init = -1, alpha_min = -1, alpha_max = -1;
   GLint tolerance = -1, weight_cap = -1, prior = -1, kd_max = -1, ks_max = -1, threshold = -1;
-  GLint max_iterations = -1, min_specular = -1;
+  GLint max_iterations = -1, min_specular = -1, min_lobe = -1, lobe_threshold = -1;
 };
 
 // One set of buffers for a dispatch batch.
@@ -116,12 +116,14 @@ void work_order(const SampleChunk &chunk, uint32_t first, uint32_t end, const Ph
                 std::vector<uint32_t> &order) {
   order.resize(end - first);
   auto iterating = [&](uint32_t i) {
-    int n_high = 0;
+    int n_high = 0, n_lobe = 0;
     for (uint32_t k = chunk.offsets[first + i]; k < chunk.offsets[first + i + 1]; ++k) {
       const Sample &s = chunk.samples[k];
-      n_high += !(s.flags & (kShadowed | kSaturated | kNotSeen)) && s.n_dot_l > 0 && s.r_dot_e > o.specular_threshold;
+      const bool usable = !(s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) && s.n_dot_l > 0;
+      n_high += usable && s.r_dot_e > o.specular_threshold;
+      n_lobe += usable && s.r_dot_e > o.lobe_threshold;
     }
-    return n_high >= o.min_specular_samples;
+    return n_high >= o.min_specular_samples || n_lobe >= o.min_lobe_samples;
   };
   size_t head = 0, tail = order.size();
   for (uint32_t i = 0; i < end - first; ++i) (iterating(i) ? order[head++] : order[--tail]) = i;
@@ -172,7 +174,8 @@ PhongFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_p
                  {&u.weight_cap, "u_weight_cap"},     {&u.prior, "u_prior"},
                  {&u.kd_max, "u_kd_max"},             {&u.ks_max, "u_ks_max"},
                  {&u.threshold, "u_specular_threshold"}, {&u.max_iterations, "u_max_iterations"},
-                 {&u.min_specular, "u_min_specular"}};
+                 {&u.min_specular, "u_min_specular"}, {&u.min_lobe, "u_min_lobe"},
+                 {&u.lobe_threshold, "u_lobe_threshold"}};
     for (const auto &n : names) {
       *n.location = gl.GetUniformLocation(program, n.name);
       if (*n.location < 0)
@@ -221,6 +224,8 @@ void PhongFitGpu::Impl::set_options(const PhongFitOptions &o) const {
   gl.Uniform1f(u.threshold, o.specular_threshold);
   gl.Uniform1i(u.max_iterations, o.max_iterations);
   gl.Uniform1i(u.min_specular, o.min_specular_samples);
+  gl.Uniform1i(u.min_lobe, o.min_lobe_samples);
+  gl.Uniform1f(u.lobe_threshold, o.lobe_threshold);
 }
 
 // End of the batch starting at vertex `first`: at most batch_vertices vertices and batch_bytes of

@@ -122,8 +122,47 @@ def check(out_path, input_mesh_path, gt_path, fit="scalar", max_rel=None, max_de
             failures.append(f"mean relative error {chosen['mean_rel']:.4f} > {max_rel} ({fit} fit)")
         if max_de is not None and chosen["mean_de2000"] > max_de:
             failures.append(f"mean CIEDE2000 {chosen['mean_de2000']:.3f} > {max_de} ({fit} fit)")
+    params = parameter_errors(v, gt.vertex)
+    if params:
+        report["params"] = params
     report["failures"] = failures
     return report
+
+
+def parameter_errors(v, g):
+    """Phong parameter error against a synthetic ground truth (kd, ks, shininess, albedo_*), where
+    both exist: rho = kd*C for every fitted vertex; ks and shininess on vertices with a full fit
+    whose true ks > 0.2 (a visible specular term); false specular on truly diffuse vertices."""
+    need_out = ["kd", "ks", "shininess", "fit_status", "color_r"]
+    need_gt = ["kd", "ks", "shininess", "albedo_r"]
+    if not all(n in v.dtype.names for n in need_out) or not all(n in g.dtype.names for n in need_gt):
+        return None
+    fitted = v["fit_status"] > 0.5
+    rho = np.stack([v["kd"] * v[c] for c in ("color_r", "color_g", "color_b")], 1)
+    rho_gt = np.stack([g[c] for c in ("albedo_r", "albedo_g", "albedo_b")], 1)
+    r = {"fitted": int(fitted.sum())}
+    if fitted.any():
+        rel = np.abs(rho[fitted] - rho_gt[fitted]).sum(1) / np.maximum(rho_gt[fitted].sum(1), 0.02)
+        r["rho_median_rel"] = float(np.median(rel))
+    glossy = fitted & (g["ks"] > 0.2)
+    full = glossy & (v["fit_status"] > 1.5)
+    r["glossy_vertices"] = int(glossy.sum())
+    r["glossy_with_full_fit"] = int(full.sum())
+    # k_s and shininess are well determined with >= 2 clean highlight samples; fits freed by the
+    # broad-lobe rule (samples with R.E > 0.5 only) render well but trade k_s against alpha.
+    determined = full & (v["n_specular"] >= 2)
+    r["glossy_well_determined"] = int(determined.sum())
+    if determined.any():
+        r["ks_median_rel"] = float(np.median(np.abs(v["ks"][determined] - g["ks"][determined]) / g["ks"][determined]))
+        r["shininess_median_rel"] = float(np.median(np.abs(v["shininess"][determined] - g["shininess"][determined])
+                                                    / g["shininess"][determined]))
+    lobe_only = full & (v["n_specular"] < 2)
+    if lobe_only.any():
+        r["lobe_only_ks_median_rel"] = float(np.median(np.abs(v["ks"][lobe_only] - g["ks"][lobe_only]) / g["ks"][lobe_only]))
+    diffuse = fitted & (g["ks"] == 0)
+    if diffuse.any():
+        r["false_specular_fraction"] = float(np.mean(v["ks"][diffuse] > 0.05))
+    return r
 
 
 def print_report(r, label=""):
@@ -138,6 +177,10 @@ def print_report(r, label=""):
             mark = "  (all coloured vertices)" if mode == r.get("fit") else ""
             print(f"  {mode:7s} fit: mean rel err {e['mean_rel']:.4f} (median {e['median_rel']:.4f}), "
                   f"mean CIEDE2000 {e['mean_de2000']:.3f} (p95 {e['p95_de2000']:.3f}){mark}")
+    if "params" in r:
+        p = r["params"]
+        print("  Phong parameters vs ground truth: " + ", ".join(
+            f"{k} {val:.4f}" if isinstance(val, float) else f"{k} {val}" for k, val in p.items()))
     if "clean" in r:
         e = r["clean"]
         print(f"  clean pixels only ({e['vertices']} vertices, {r.get('fit')} fit): mean rel err {e['mean_rel']:.4f} "

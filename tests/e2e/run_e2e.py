@@ -98,7 +98,32 @@ def cmd_fit(a):
     r = check_output.check(out_ply, mlp_mesh(a.project), a.gt, a.fit, a.max_rel, a.max_de, a.min_coverage,
                            a.max_de_all)
     check_output.print_report(r, os.path.basename(os.path.dirname(os.path.abspath(a.project))))
-    return 1 if r["failures"] else 0
+    failed = bool(r["failures"])
+    p = r.get("params", {})
+    for key, bound, worse in (("ks_median_rel", a.max_ks_rel, lambda x, b: x > b),
+                              ("shininess_median_rel", a.max_shininess_rel, lambda x, b: x > b)):
+        if bound is not None and (key not in p or worse(p[key], bound)):
+            print(f"  FAIL: {key} {p.get(key)} exceeds {bound}")
+            failed = True
+    if a.min_full_fits is not None:
+        share = p.get("glossy_with_full_fit", 0) / max(1, p.get("glossy_vertices", 0))
+        print(f"  glossy vertices with a full fit: {share:.3f}")
+        if share < a.min_full_fits:
+            print(f"  FAIL: only {share:.3f} of the glossy vertices got a full fit (< {a.min_full_fits})")
+            failed = True
+    if a.heldout:  # relit error on photos held out from the fit (vbrdf_eval, OSMesa)
+        cmd = [a.eval_tool, "--result", out_ply, "--project", a.heldout]
+        if a.heldout_photo_dir:
+            cmd += ["--photo-dir", a.heldout_photo_dir]
+        if a.max_relit_mean is not None:
+            cmd += ["--max-mean-de", str(a.max_relit_mean)]
+        if a.max_relit_p95 is not None:
+            cmd += ["--max-p95-de", str(a.max_relit_p95)]
+        print("running:", " ".join(cmd))
+        ev = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        print(ev.stdout)
+        failed |= ev.returncode != 0
+    return 1 if failed else 0
 
 
 def moved_mesh_copy(mlp, out_mlp, out_mesh):
@@ -293,6 +318,14 @@ def main(argv=None):
     fit.add_argument("--max-de", type=float, help="bound on the mean CIEDE2000 of clean-pixel vertices")
     fit.add_argument("--max-de-all", type=float, help="bound on the mean CIEDE2000 of all coloured vertices")
     fit.add_argument("--min-coverage", type=float)
+    fit.add_argument("--heldout", help="held-out project.mlp: score the relit error with --eval-tool")
+    fit.add_argument("--heldout-photo-dir", help="photos for the held-out project (same file names)")
+    fit.add_argument("--eval-tool", help="the vbrdf_eval binary")
+    fit.add_argument("--max-relit-mean", type=float)
+    fit.add_argument("--max-relit-p95", type=float)
+    fit.add_argument("--min-full-fits", type=float, help="fraction of truly glossy vertices with a full fit")
+    fit.add_argument("--max-ks-rel", type=float, help="bound on the median relative k_s error")
+    fit.add_argument("--max-shininess-rel", type=float, help="bound on the median relative shininess error")
     sub.choices["bad"].add_argument("--case", required=True)
     a = ap.parse_args(argv)
     return {"fit": cmd_fit, "bad": cmd_bad, "dump": cmd_dump}[a.command](a)
