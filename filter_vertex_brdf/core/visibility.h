@@ -17,8 +17,15 @@ struct VisibilitySettings {
   // when it is at most this much behind the first surface along the ray.
   float depth_tolerance = 0.002f;
   // Resolution (square) of the light-view orthographic depth map over the mesh bounds.
-  int shadow_map_size = 2048;
+  // 0 = automatic (resolved_shadow_map_size).
+  int shadow_map_size = 0;
 };
+
+// The shadow-map resolution to use: `settings.shadow_map_size` when positive; for 0, the power of
+// two that makes a texel at most a quarter of the median edge length over the mesh's bounding
+// sphere, clamped to [1024, 4096] (a shadow edge is then placed to within a fraction of a vertex
+// spacing; finer maps cost time, quadratically, and change few vertices' flags). Throws InputError when negative.
+int resolved_shadow_map_size(const MeshView &mesh, const VisibilitySettings &settings);
 
 class VisibilityBackend {
 public:

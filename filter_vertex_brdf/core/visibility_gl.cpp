@@ -122,10 +122,8 @@ GlVisibility::GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_pro
     if (mesh.indices[i] >= mesh.vertex_count)  // an out-of-range index can crash the GL driver
       throw InputError("OpenGL visibility: face " + std::to_string(i / 3) + " references vertex " +
                        std::to_string(mesh.indices[i]) + " which does not exist.");
-  if (settings.shadow_map_size <= 0)
-    throw InputError("OpenGL visibility: the shadow map size must be positive (got " +
-                     std::to_string(settings.shadow_map_size) + ").");
-  check_target_size(settings.shadow_map_size, settings.shadow_map_size, "the light-view shadow map");
+  settings_.shadow_map_size = resolved_shadow_map_size(mesh, settings);
+  check_target_size(settings_.shadow_map_size, settings_.shadow_map_size, "the light-view shadow map");
 
   const Bounds b = compute_bounds(mesh);
   tolerance_ = settings.depth_tolerance * b.diagonal();

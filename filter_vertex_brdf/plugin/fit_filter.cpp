@@ -103,9 +103,10 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   params.addParam(RichFloat(kDepthTolerance, 0.002f, "Depth tolerance",
                             "A vertex counts as visible (or lit) when it is at most this far behind the first "
                             "surface along the ray, as a fraction of the bounding-box diagonal."));
-  params.addParam(RichInt(kShadowMapSize, 2048, "Shadow map size",
+  params.addParam(RichInt(kShadowMapSize, 0, "Shadow map size",
                           "Resolution (pixels per side) of the depth map rendered from each light direction "
-                          "over the mesh bounds (OpenGL visibility)."));
+                          "over the mesh bounds (OpenGL visibility). 0: automatic, from the mesh's edge "
+                          "length (a texel about a quarter of an edge, 1024 to 4096)."));
   params.addParam(RichInt(kMemoryBudgetMB, 2048, "Photo memory (MB)",
                           "Decoded photos kept in memory at once; photos beyond it are reloaded when "
                           "needed."));
@@ -153,7 +154,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   const float tolerance = params.getFloat(kDepthTolerance);
   require(std::isfinite(tolerance) && tolerance > 0.0f && tolerance < 1.0f, kDepthTolerance, "must be in (0, 1)");
   const int map_size = params.getInt(kShadowMapSize);
-  require(map_size >= 64 && map_size <= 16384, kShadowMapSize, "must be in [64, 16384]");
+  require(map_size == 0 || (map_size >= 64 && map_size <= 16384), kShadowMapSize, "must be 0 (automatic) or in [64, 16384]");
   const int budget = params.getInt(kMemoryBudgetMB);
   require(budget >= 16, kMemoryBudgetMB, "must be at least 16");
   const int fit_backend = params.getEnum(kFitBackend);
