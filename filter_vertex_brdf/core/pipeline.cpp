@@ -236,7 +236,8 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
         << "  diffuse-only (k_s = 0; k_s/alpha stages skipped: fewer than " << settings.phong.min_specular_samples
-        << " clean highlight samples or no specular term): " << r.fit_diffuse_only << "\n"
+        << " clean highlight samples and fewer than " << settings.phong.min_lobe_samples
+        << " samples with R.E > " << settings.phong.lobe_threshold << ", or no specular term): " << r.fit_diffuse_only << "\n"
         << "  no usable sample (sentinels: k_d = k_s = shininess = 0): " << r.fit_none << "\n"
         << "  converged before the cap of " << settings.phong.max_iterations << " iterations: " << r.fit_converged
         << " of " << r.fit_full << " full fits; alpha iterations run: " << r.fit_iterations << " of at most "
@@ -244,6 +245,21 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   } else {
     rep << "Phong fit: off (basic diffuse colour only)\n";
   }
+  // What skipping saved, estimated from the measured rates (the skipped work was never run).
+  const double per_pair = r.seconds_gather > 0 && g.stored ? (r.seconds_gather - r.seconds_fit) / double(g.stored) : 0;
+  rep << "skipped work (estimated saving): " << g.rasters_skipped << " raster x chunk pairs not read; "
+      << (g.pairs - g.stored) << " vertex-photo pairs not sampled (not seen), ~"
+      << fixed(per_pair * double(g.pairs - g.stored), 2) << " s";
+  if (!r.fits.empty()) {
+    const uint64_t fitted = r.fit_full + r.fit_diffuse_only;
+    const uint64_t cap_work = fitted * uint64_t(std::max(0, settings.phong.max_iterations));
+    // Cost model: set-up of a vertex ~ 2 iterations (tests/bench/FIT_PERFORMANCE.md).
+    const double per_iteration = r.seconds_fit / double(std::max<uint64_t>(1, r.fit_iterations + 2 * fitted));
+    rep << "; " << (cap_work - std::min<uint64_t>(cap_work, r.fit_iterations))
+        << " shininess iterations not run (diffuse-only or converged vertices), ~"
+        << fixed(per_iteration * double(cap_work - std::min<uint64_t>(cap_work, r.fit_iterations)), 2) << " s";
+  }
+  rep << "\n";
   rep << "time: visibility " << fixed(r.seconds_visibility) << " s, samples " << fixed(r.seconds_gather - r.seconds_fit)
       << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
       << g.rasters_skipped << " raster x chunk pairs skipped)\n";

@@ -2,6 +2,8 @@
 //   vbrdf_fit project.mlp [--lp lights.lp] [--out result.ply] [--visibility auto|gl|cpu]
 //             [--ts 0.9] [--td 0.5] [--encoding auto|srgb|linear] [--shadow-map 2048]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
+//             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
+//                                one highlight sample; to show the diffuse holes it causes)
 // Exit status: 0 success, 2 bad input (message on stderr), 3 processing error.
 #include <cstdio>
 #include <cstring>
@@ -41,6 +43,12 @@ int main(int argc, char **argv) {
     else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
     else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
+    else if (a == "--no-remedies") {
+      settings.phong.specular_weight_cap = 1e30f;
+      settings.phong.diffuse_prior = 0;
+      settings.phong.min_specular_samples = 1;
+      settings.phong.min_lobe_samples = 1 << 30;
+    }
     else if (a == "--fit") {
       const std::string v = next();
       settings.fit_reflectance = v != "off";
