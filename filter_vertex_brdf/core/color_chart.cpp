@@ -15,8 +15,8 @@ namespace vbrdf {
 
 namespace {
 
-// mcc's ColorChecker Classic template: the chart's box is 16.75 x 11.25 units, patch centres at
-// 1.5 + 2.75 k (OpenCV contrib mcc, CChartModel MCC24).
+// mcc's ColorChecker Classic template: the detector's box is 16.75 x 11.25 units (CChartModel
+// MCC24); patch centres at 1.5 + 2.75 k in it (checked within 4 px on the Mitsuba scenes' charts).
 constexpr float kBoxW = 16.75f, kBoxH = 11.25f, kFirstCentre = 1.5f, kPitch = 2.75f;
 
 std::string fmt(const char *format, double a = 0, double b = 0, double c = 0, double d = 0) {
@@ -267,17 +267,30 @@ std::vector<double> chart_brightness(const std::vector<PatchMeasurement> &patche
   return b;
 }
 
-// Median over photos of each patch divided by its photo's chart brightness.
+// Each patch over the photos, relative to the photo's chart brightness: the ratio of sums over
+// the photos that agree with the median (bright photos weigh more, their 8-bit steps are finer;
+// a patch shadowed or glinting in one photo is left out).
 PatchColors pooled_patches(const std::vector<PatchMeasurement> &patches, const std::vector<double> &brightness,
                            PatchFlags &usable) {
   PatchColors out{};
   for (int k = 0; k < kChartPatches; ++k) {
-    std::vector<double> ch[3];
+    std::vector<size_t> photos;
+    std::vector<double> lum;
     for (size_t p = 0; p < patches.size(); ++p)
-      if (brightness[p] > 0 && patches[p].usable[k])
-        for (int c = 0; c < 3; ++c) ch[c].push_back(patches[p].rgb[k][c] / brightness[p]);
-    usable[k] = !ch[0].empty();
-    for (int c = 0; c < 3; ++c) out[k][c] = float(median_of(ch[c]));
+      if (brightness[p] > 0 && patches[p].usable[k]) {
+        photos.push_back(p);
+        lum.push_back(luminance(patches[p].rgb[k].data()) / brightness[p]);
+      }
+    usable[k] = !photos.empty();
+    if (!usable[k]) continue;
+    const double med = median_of(lum);
+    double sum[3] = {0, 0, 0}, weight = 0;
+    for (size_t n = 0; n < photos.size(); ++n) {
+      if (std::fabs(lum[n] - med) > 0.1 * med + 1e-4) continue;
+      for (int c = 0; c < 3; ++c) sum[c] += patches[photos[n]].rgb[k][c];
+      weight += brightness[photos[n]];
+    }
+    for (int c = 0; c < 3; ++c) out[k][c] = float(sum[c] / weight);
   }
   return out;
 }
@@ -348,7 +361,7 @@ std::vector<double> exposure_divisors(const std::vector<double> &b, const std::v
     // E_p = b_p / (n . L_p); photos where the chart barely faces the light keep the median.
     std::vector<double> es;
     for (size_t p = 0; p < b.size(); ++p) {
-      const auto &l = (*lights)[p];
+      const std::array<double, 3> l = p < lights->size() ? (*lights)[p] : std::array<double, 3>{{0, 0, 0}};
       const double cosine = l[0] * n[0] + l[1] * n[1] + l[2] * n[2];
       d[p] = b[p] > 0 && cosine > 0.2 ? b[p] / cosine : 0;
       if (d[p] > 0) es.push_back(d[p]);

@@ -128,7 +128,10 @@ struct ColorCalibration {
   ColorCorrection correction;
   CorrectionFit fit;
   ChartLocation chart;
-  std::vector<double> divisor;      // per photo: corrected = M(rgb / divisor)
+  // Per photo: the camera value of a perfect white facing the light (camera gain x light
+  // intensity at the chart); corrected = M(rgb / divisor). The same for all photos unless
+  // exposure_normalised.
+  std::vector<double> divisor;
   bool exposure_normalised = false; // divisors differ per photo (varying light intensity)
   std::vector<PatchMeasurement> patches;  // per photo
   std::vector<std::string> log;     // for the user: what was found and done

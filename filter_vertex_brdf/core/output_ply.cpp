@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <unistd.h>
 
@@ -21,6 +22,19 @@ class OutVertex : public vcg::Vertex<OutTypes, vcg::vertex::Coord3f, vcg::vertex
                                      vcg::vertex::BitFlags> {};
 class OutFace : public vcg::Face<OutTypes, vcg::face::VertexRef, vcg::face::BitFlags> {};
 class OutMesh : public vcg::tri::TriMesh<std::vector<OutVertex>, std::vector<OutFace>> {};
+
+// PlyInfo::AddPerVertexFloatAttribute must not be used: it keeps pointers to the vectors of the
+// FIRST PlyInfo it ever saw in function-local statics, so a second export in the same process
+// (running the filter twice in MeshLab) writes into a destroyed object. Same fields, set here.
+void add_float_property(vcg::tri::io::PlyInfo &info, const std::string &name) {
+  info.VertDescriptorVec.push_back(vcg::ply::PropDescriptor());
+  info.VertAttrNameVec.push_back(name);
+  vcg::ply::PropDescriptor &d = info.VertDescriptorVec.back();
+  d.elemname = "vertex";
+  d.propname = strdup(name.c_str());  // vcglib's descriptor owns a C string (freed by nobody, as in vcglib)
+  d.stotype1 = vcg::ply::T_FLOAT;
+  d.memtype1 = vcg::ply::T_FLOAT;
+}
 
 std::string temporary_path_for(const std::string &path) {
   return path + ".tmp" + std::to_string(::getpid());
@@ -64,7 +78,7 @@ void write_result_ply(const std::string &path, const MeshView &mesh, const std::
   for (const VertexAttribute &a : attributes) {
     auto handle = vcg::tri::Allocator<OutMesh>::AddPerVertexAttribute<float>(m, a.name);
     for (size_t v = 0; v < mesh.vertex_count; ++v) handle[v] = a.values[v];
-    info.AddPerVertexFloatAttribute(a.name.c_str());
+    add_float_property(info, a.name);
   }
 
   const std::string tmp = temporary_path_for(path);

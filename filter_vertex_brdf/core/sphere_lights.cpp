@@ -53,20 +53,18 @@ void orthonormal_basis(const double axis[3], double e1[3], double e2[3]) {
   normalize3(e2);
 }
 
-// Outline circle (centroid, mean radius) of a model's projected contour.
+// Outline circle of a model: the projected contour is an ellipse; its centre and the geometric
+// mean of its semi-axes are what a circle fitted to it gives (and what a user measures).
 SphereCircle outline_circle(const SphereCamera &cam, const SphereModel &m) {
   if (!cam.perspective) return m.circle;
-  const std::vector<cv::Point2d> pts = sphere_outline(cam, m, 128);
+  const std::vector<cv::Point2d> pts = sphere_outline(cam, m, 64);
   SphereCircle c;
-  if (pts.empty()) return c;
-  for (const auto &p : pts) {
-    c.x += p.x;
-    c.y += p.y;
-  }
-  c.x /= double(pts.size());
-  c.y /= double(pts.size());
-  for (const auto &p : pts) c.r += std::hypot(p.x - c.x, p.y - c.y);
-  c.r /= double(pts.size());
+  if (pts.size() < 5) return c;
+  std::vector<cv::Point2f> f(pts.begin(), pts.end());
+  const cv::RotatedRect e = cv::fitEllipse(f);
+  c.x = e.center.x;
+  c.y = e.center.y;
+  c.r = 0.5 * std::sqrt(double(e.size.width) * double(e.size.height));
   return c;
 }
 
@@ -450,7 +448,7 @@ SphereModel sphere_from_circle(const SphereCamera &cam, const SphereCircle &circ
   double x, y;
   if (!project_direction(cam, axis, x, y)) return SphereModel{};
   SphereModel m = sphere_from_centre(cam, x, y, std::acos(c));
-  // The plane fit treats the circle as the outline; the true outline is an ellipse whose centroid
+  // The plane fit treats the circle as the outline; the true outline is an ellipse whose centre
   // and mean radius should match the circle: a few fixed-point steps make them match.
   for (int iter = 0; iter < 8 && m.circle.r > 0; ++iter) {
     const double dx = circle.x - m.circle.x, dy = circle.y - m.circle.y, k = circle.r / m.circle.r;
@@ -792,7 +790,7 @@ std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load,
 
   // Candidates (full-resolution coordinates).
   std::vector<Candidate> cands;
-  // HoughCircles on (a region of) a reduced image. Square root, then a high percentile to white:
+  // HoughCircles on (a region of) a reduced image. Fourth root, then a high percentile to white:
   // a dark sphere on a dark ground keeps an outline Canny can see; the highlights clip, which
   // does not matter for the outline.
   auto add_hough = [&](const cv::Mat &img, cv::Rect roi, double percentile, double r_lo, double r_hi,
@@ -945,9 +943,8 @@ std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load,
   for (const Candidate &c : kept) {
     if (int(found.size()) >= search.max_spheres) break;
     DetectedSphere d;
-    // Final refinement on linear intensities (no stretch), where an anti-aliased outline is
-    // exactly half-way between inside and outside; the median image is only used at full
-    // resolution.
+    // Final refinement at full resolution (see refine_sphere); the median image exists at full
+    // resolution only when the photos were not reduced.
     const cv::Mat &fine = c.on_median && scale == 1 ? full_med : full_max;
     d.model = refine_sphere(fine, cam, c.model, 2.0);
     d.method = c.hough ? SphereMethod::Hough : SphereMethod::HighlightTrack;
@@ -955,7 +952,7 @@ std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load,
     d.highlights_inside = c.support;
     d.description = fmt("centre (%.2f, %.2f), radius %.2f px", d.model.circle.x, d.model.circle.y,
                         d.model.circle.r) +
-                    fmt(", outline contrast %.2f, brightest spot inside in %.0f of %.0f photos", c.score,
+                    fmt(", outline contrast %.2f, a bright spot inside in %.0f of %.0f photos", c.score,
                         c.support, double(count)) +
                     "; found by " + join(c.sources);
     found.push_back(d);
@@ -995,6 +992,7 @@ bool closest_point_to_rays(const std::vector<std::array<double, 3>> &origins,
     cv::Vec3d d(dirs[i][0], dirs[i][1], dirs[i][2]);
     d /= cv::norm(d);
     const cv::Vec3d r = x - cv::Vec3d(origins[i][0], origins[i][1], origins[i][2]);
+    if (r.dot(d) <= 0) return false;  // the rays diverge: no point in front of them
     const cv::Vec3d perp = r - d * r.dot(d);
     sum += perp.dot(perp);
   }
@@ -1105,7 +1103,9 @@ LightCalibration calibrate_lights(size_t count, const GrayLoader &load, const Sp
         for (size_t b = a + 1; b < dirs.size(); ++b)
           pl.disagreement_deg = std::max(pl.disagreement_deg, angle_deg(dirs[a].data(), dirs[b].data()));
       if (dirs.size() >= 2) disagreements.push_back(pl.disagreement_deg);
-      pl.has_position = closest_point_to_rays(origins, dirs, pl.position, &pl.position_rms);
+      // Spheres that agree within noise see a distant light: its position would be noise.
+      pl.has_position = pl.disagreement_deg >= settings.min_triangulation_deg &&
+                        closest_point_to_rays(origins, dirs, pl.position, &pl.position_rms);
       positions += pl.has_position ? 1 : 0;
     }
     if (!problems.empty()) {

@@ -57,7 +57,8 @@ struct SphereCircle {
 
 // A sphere located in a viewpoint.
 struct SphereModel {
-  SphereCircle circle;           // outline: centroid and mean radius of the projected contour
+  SphereCircle circle;           // outline: centre of the projected contour (an ellipse) and the
+                                 // geometric mean of its semi-axes
   double axis[3] = {0, 0, -1};   // perspective: unit ray to the sphere's centre
   double half_angle = 0;         // perspective: angle between the axis and a tangent ray (rad)
   double centre_x = 0, centre_y = 0;  // image of the sphere's centre (== circle centre if orthographic)
@@ -142,21 +143,28 @@ struct SphereSearch {
   int detect_size = 512;       // larger photos are searched at this size, then refined in full
 };
 
-// Loads photo `index` as a grey image (see gray_image()). Called at most twice per photo.
+// Loads photo `index` as a linear grey image (see gray_image()). Detection calls it once per photo
+// (twice for photos larger than SphereSearch::detect_size); the highlights need one more pass.
 using GrayLoader = std::function<cv::Mat(size_t index)>;
 
-// Finds up to search.max_spheres spheres in the photos of one viewpoint: HoughCircles on the
-// median and on the max image of all photos (square-root stretched so that a dark sphere's faint
-// glow shows), plus a candidate from the track of the photos' highlights (for a black or mirror
-// sphere in a dark room, whose outline barely shows); every candidate is refined to the
-// strongest outline and kept only when fully inside the image. Appends what it did to `log`
-// (including candidates rejected because the image border cuts them). Returns an empty vector
-// when no sphere is found.
+// Finds up to search.max_spheres spheres in the photos of one viewpoint. Candidates: HoughCircles
+// on the median and on the max image of all photos (power-stretched so that a dark sphere's faint
+// glow shows), HoughCircles in the neighbourhood of the highlight track, and the outermost
+// circular edge around the track (a black or mirror sphere in a dark room barely shows an
+// outline, but the brightest spots of all photos stay inside it). A candidate is kept when it
+// holds a bright spot in at least 70 % of the photos that have one (or, with no spots at all,
+// when its outline scores min_edge_score), when its outline is round all around, and when it is
+// fully inside the image; it is refined to the strongest outline (centre) and to the half-way
+// crossing of the linear intensities (radius). Appends what it did to `log`, including candidates
+// rejected because the image border cuts them. Returns an empty vector when nothing is found.
 std::vector<DetectedSphere> detect_spheres(size_t photo_count, const GrayLoader &load, const SphereCamera &cam,
                                            const SphereSearch &search, std::vector<std::string> &log);
 
-// Refines a sphere to the strongest outline in `gray` within +-max_shift pixels (centre and
-// radius). Returns the refined model and its edge score in `score` (optional).
+// Refines a sphere in a linear grey image within +-max_shift pixels: the centre to the strongest
+// outline of the square-root image (its edge shift is the same all around, so it does not move
+// the centre), then the radius to where the intensity crosses half-way between inside and
+// outside (exact for an anti-aliased edge under any symmetric blur). `score` (optional) receives
+// minus the relative crossing mismatch (0 is perfect).
 SphereModel refine_sphere(const cv::Mat &gray, const SphereCamera &cam, const SphereModel &start, double max_shift,
                           double *score = nullptr);
 
@@ -165,6 +173,7 @@ struct LightSettings {
   SphereSearch search;
   HighlightSettings highlight;
   double sphere_radius_world = 0;  // > 0: triangulated positions scaled to world units
+  double min_triangulation_deg = 1.0;  // spheres agreeing better than this: distant light, no position
   bool decode_srgb = true;          // photos given as cv::Mat: 8-bit ones are sRGB-encoded
 };
 
@@ -179,7 +188,7 @@ struct PhotoLight {
   double dir[3] = {0, 0, 0};        // unit, camera frame: normalised mean over the spheres
   std::vector<SphereLight> spheres; // one per sphere, in LightCalibration::spheres order
   double disagreement_deg = 0;      // largest angle between two spheres' directions
-  bool has_position = false;        // triangulated near-light position (two or more spheres)
+  bool has_position = false;        // triangulated near light (two or more spheres that disagree)
   double position[3] = {0, 0, 0};   // camera frame (units: see the header comment)
   double position_rms = 0;          // RMS distance of the reflected rays from the position
   std::string warning;              // per-photo problem, empty when all spheres gave a light
@@ -208,8 +217,9 @@ LightCalibration calibrate_lights(const std::vector<cv::Mat> &photos, const Sphe
 // .lp entries for the photos that got a light (file names as given), in photo order.
 std::vector<LightEntry> light_entries(const LightCalibration &calibration, const std::vector<std::string> &image_names);
 
-// Least-squares point closest to rays origin[i] + t dir[i] (dir need not be normalised). Returns
-// false for fewer than two rays or (nearly) parallel rays. `rms` receives the RMS distance.
+// Least-squares point closest to rays origin[i] + t dir[i], t > 0 (dir need not be normalised).
+// Returns false for fewer than two rays, (nearly) parallel rays, or a point behind a ray's
+// origin. `rms` receives the RMS distance of the rays from the point.
 bool closest_point_to_rays(const std::vector<std::array<double, 3>> &origins,
                            const std::vector<std::array<double, 3>> &dirs, double point[3], double *rms = nullptr);
 

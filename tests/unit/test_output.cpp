@@ -64,3 +64,20 @@ TEST(OutputPly, RefusesNaNAndLeavesNoFileBehind) {
   EXPECT_THROW(write_result_ply("/nonexistent_dir/out.ply", mesh.view(), std::vector<uint8_t>(4 * n, 0), {}),
                ProcessingError);
 }
+
+TEST(OutputPly, RepeatedExportsInOneProcessStayCorrect) {
+  // vcglib's PlyInfo::AddPerVertexFloatAttribute caches the first PlyInfo's vectors in statics:
+  // a second export then corrupts memory. Several exports in a row must all read back.
+  const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
+  const size_t n = mesh.positions.size() / 3;
+  for (int run = 0; run < 4; ++run) {
+    std::vector<VertexAttribute> attrs = {{"a" + std::to_string(run), std::vector<float>(n, float(run))},
+                                          {"b", std::vector<float>(n, 2.0f * float(run))}};
+    const std::string path = test::scratch_dir("ply_repeat") + "/out.ply";
+    write_result_ply(path, mesh.view(), std::vector<uint8_t>(4 * n, 1), attrs);
+    const std::string data = read_all(path);
+    EXPECT_NE(data.find("property float a" + std::to_string(run) + "\n"), std::string::npos) << run;
+    EXPECT_NE(data.find("property float b\n"), std::string::npos) << run;
+    EXPECT_EQ(data.find("property float a" + std::to_string(run - 1) + "\n"), std::string::npos) << run;
+  }
+}
