@@ -1,5 +1,6 @@
 #include "pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -44,6 +45,23 @@ int bit(uint16_t flag) {
   while (flag > 1) flag >>= 1, ++i;
   return i;
 }
+
+bool nearly_equal(double a, double b) {
+  return std::fabs(a - b) <= 1e-6 * std::max({1.0, std::fabs(a), std::fabs(b)});
+}
+
+bool same_shot(const Shot &a, const Shot &b) {
+  const auto &ia = a.Intrinsics, &ib = b.Intrinsics;
+  bool same = ia.ViewportPx == ib.ViewportPx && nearly_equal(ia.FocalMm, ib.FocalMm);
+  for (int k = 0; k < 2; ++k)
+    same = same && nearly_equal(ia.PixelSizeMm[k], ib.PixelSizeMm[k]) && nearly_equal(ia.CenterPx[k], ib.CenterPx[k]) &&
+           nearly_equal(ia.k[k], ib.k[k]);
+  const auto ra = a.Extrinsics.Rot(), rb = b.Extrinsics.Rot();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) same = same && nearly_equal(ra[r][c], rb[r][c]);
+  for (int k = 0; k < 3; ++k) same = same && nearly_equal(a.Extrinsics.Tra()[k], b.Extrinsics.Tra()[k]);
+  return same;
+}
 } // namespace
 
 std::string default_output_path(const std::string &project_path) {
@@ -72,6 +90,17 @@ std::vector<std::array<float, 3>> resolve_light_directions(const std::vector<Ras
                          "' matches no raster. Use the .lp written for these photos.");
   }
   return dirs;
+}
+
+std::vector<std::vector<size_t>> rasters_by_viewpoint(const std::vector<Raster> &rasters) {
+  std::vector<std::vector<size_t>> groups;
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    const auto same = [&](const std::vector<size_t> &g) { return same_shot(rasters[g.front()].shot, rasters[r].shot); };
+    auto it = std::find_if(groups.begin(), groups.end(), same);
+    if (it == groups.end()) it = groups.insert(groups.end(), std::vector<size_t>());
+    it->push_back(r);
+  }
+  return groups;
 }
 
 void validate_input(const FitInput &input) {
@@ -134,6 +163,143 @@ private:
   PhongFitGpu gpu_;
   std::string name_;
 };
+
+// ---- Colour correction (color_chart.h), per viewpoint ----
+
+// Where each raster's samples find their correction.
+struct ColorPlan {
+  std::vector<ColorCalibration> viewpoints;
+  std::vector<uint32_t> viewpoint_of, photo_of;  // per raster: viewpoint, index among its photos
+  bool any_corrected() const {
+    return std::any_of(viewpoints.begin(), viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; });
+  }
+};
+
+// Linear RGB float through the photo's own table, so the chart is measured exactly as the samples are.
+template <typename T>
+cv::Mat decode_linear(const Photo &photo) {
+  cv::Mat out(photo.pixels.size(), CV_32FC3);
+  for (int y = 0; y < out.rows; ++y) {
+    const T *in = photo.pixels.ptr<T>(y);
+    float *o = out.ptr<float>(y);
+    for (int i = 0; i < 3 * out.cols; ++i) o[i] = photo.lut[in[i]];
+  }
+  return out;
+}
+
+cv::Mat linear_rgb_of(const Photo &photo) {
+  return photo.pixels.depth() == CV_16U ? decode_linear<uint16_t>(photo) : decode_linear<uint8_t>(photo);
+}
+
+std::string viewpoint_name(const FitInput &input, const std::vector<size_t> &group, size_t v, size_t count) {
+  return "Viewpoint " + std::to_string(v + 1) + " of " + std::to_string(count) + " (" + std::to_string(group.size()) +
+         " photo(s), first raster '" + input.rasters[group.front()].label + "')";
+}
+
+// Chart settings of viewpoint `v`: detection, or its corners (8 numbers shared by all viewpoints,
+// or 8 per viewpoint).
+ColorSettings color_settings_for(const FitSettings &settings, size_t v, size_t viewpoints) {
+  const std::vector<float> &corners = settings.chart_corners;
+  if (!corners.empty() && corners.size() != 8 && corners.size() != 8 * viewpoints)
+    throw InputError("Parameter 'chartCorners' has " + std::to_string(corners.size()) + " numbers; give 8 (x y of "
+                     "the dark skin, bluish green, black and white patch centres) for all viewpoints, or 8 per "
+                     "viewpoint (the project has " + std::to_string(viewpoints) + "), or leave it empty to detect "
+                     "the chart.");
+  ColorSettings s;
+  s.require_chart = settings.color_correction == ColorCorrectionChoice::Required;
+  s.exposure = settings.exposure;
+  s.manual = !corners.empty();
+  const size_t first = corners.size() == 8 ? 0 : 8 * v;
+  if (s.manual) std::copy(corners.begin() + long(first), corners.begin() + long(first + 8), s.corners);
+  return s;
+}
+
+ColorCalibration calibrate_viewpoint(const FitInput &input, const ColorSettings &settings,
+                                     const std::vector<size_t> &group,
+                                     const std::vector<std::array<float, 3>> &lights_world, PhotoCache &photos,
+                                     const std::string &where) {
+  std::vector<std::string> names;
+  std::vector<std::array<double, 3>> lights_cam;  // calibrate_colors tells varying intensity from the chart's angle
+  for (size_t r : group) {
+    names.push_back(input.rasters[r].label);  // the core quotes it
+    float cam[3];
+    world_to_camera_direction(input.rasters[r].shot, lights_world[r].data(), cam);
+    lights_cam.push_back({{cam[0], cam[1], cam[2]}});
+  }
+  const RgbLoader load = [&](size_t i) {
+    const Raster &r = input.rasters[group[i]];
+    return linear_rgb_of(*photos.get(r.image_path, r.width(), r.height()));
+  };
+  try {
+    return calibrate_colors(group.size(), load, settings, &lights_cam, names);
+  } catch (const InputError &e) {
+    throw InputError("Colour correction is required (colorCorrection = Required) but failed. " + where + ": " +
+                     e.what() + " Set 'chartCorners', or set 'colorCorrection' to Auto to fit without correction.");
+  }
+}
+
+// Calibrates every viewpoint and logs what was found; InputError when Required and a chart is missing.
+ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
+                      const std::vector<std::array<float, 3>> &lights_world, PhotoCache &photos, const LogFn &log) {
+  ColorPlan plan;
+  if (settings.color_correction == ColorCorrectionChoice::Off) {
+    log("Colour correction: off (colorCorrection = Off): samples are used as decoded.");
+    return plan;
+  }
+  const std::vector<std::vector<size_t>> groups = rasters_by_viewpoint(input.rasters);
+  plan.viewpoint_of.resize(input.rasters.size());
+  plan.photo_of.resize(input.rasters.size());
+  for (size_t v = 0; v < groups.size(); ++v) {
+    const std::string where = viewpoint_name(input, groups[v], v, groups.size());
+    const ColorSettings cs = color_settings_for(settings, v, groups.size());
+    plan.viewpoints.push_back(calibrate_viewpoint(input, cs, groups[v], lights_world, photos, where));
+    const ColorCalibration &cal = plan.viewpoints.back();
+    for (size_t i = 0; i < groups[v].size(); ++i) {
+      plan.viewpoint_of[groups[v][i]] = uint32_t(v);
+      plan.photo_of[groups[v][i]] = uint32_t(i);
+    }
+    for (const std::string &line : cal.log) log(where + ": " + line);
+    if (!cal.corrected)
+      log(where + ": colour correction: " + (cal.patches.empty() ? "no chart found" : "chart not usable") +
+          ": colours uncorrected.");
+  }
+  return plan;
+}
+
+// In place, before any estimate: corrected = M(rgb / exposure). Negative results (a matrix
+// applied to noise in dark pixels) are no light: clamped to 0.
+void correct_colors(const ColorPlan &plan, SampleChunk &chunk) {
+#pragma omp parallel for schedule(static)
+  for (long long i = 0; i < (long long)chunk.samples.size(); ++i) {
+    Sample &s = chunk.samples[size_t(i)];
+    const ColorCalibration &cal = plan.viewpoints[plan.viewpoint_of[s.raster]];
+    if (!cal.corrected) continue;
+    apply_color_calibration(cal, plan.photo_of[s.raster], s.rgb);
+    for (float &c : s.rgb) c = c > 0 ? c : 0.0f;  // also NaN -> 0
+  }
+}
+
+std::string color_report(const FitResult &r, const FitSettings &settings) {
+  if (settings.color_correction == ColorCorrectionChoice::Off) return "colour correction: off\n";
+  std::ostringstream rep;
+  for (size_t v = 0; v < r.colors.size(); ++v) {
+    const ColorCalibration &c = r.colors[v];
+    rep << "colour correction, viewpoint " << v + 1 << " (" << c.divisor.size() << " photos): ";
+    if (!c.corrected) {
+      rep << (c.patches.empty() ? "no chart found" : "chart not usable") << ": colours uncorrected\n";
+      continue;
+    }
+    const double heldout = std::min({c.fit.heldout_matrix, c.fit.heldout_curve_matrix, c.fit.heldout_polynomial});
+    const std::string exposure = c.exposure_normalised
+                                     ? "normalised per photo (light intensity varies)"
+                                     : "one for all photos (divisor " + fixed(c.divisor.at(0), 4) + ")";
+    rep << correction_model_name(c.correction.model) << " from " << (c.chart.detected ? "the detected" : "the given")
+        << " chart, " << c.fit.patches << " patches, CIEDE2000 " << fixed(c.fit.before) << " -> " << fixed(c.fit.after)
+        << " (held-out " << fixed(heldout) << "); exposure " << exposure
+        << "; samples corrected in linear space before the fit\n";
+  }
+  return rep.str();
+}
 
 // Everything the chunk consumer produces, per vertex.
 void consume_chunk(const SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options, FitResult &r,
@@ -215,6 +381,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << "\n"
       << "visibility back end: " << r.visibility_backend << "\n"
+      << color_report(r, settings)
       << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
       << ", T_d (N.L) = " << settings.gather.diffuse_threshold << "\n"
       << "vertices coloured: " << r.vertices_coloured << " (" << percent(r.vertices_coloured, n) << ")\n"
@@ -316,6 +483,12 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   // Photos are validated (size, bit depth) before the long passes start.
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
   for (const Raster &r : input.rasters) photos.get(r.image_path, r.width(), r.height());
+  // Before the long passes: a required chart that is missing fails early.
+  if (progress) progress(0.0f, "colour calibration");
+  ColorPlan colors = plan_colors(input, settings, lights, photos, log);
+  const bool correct = colors.any_corrected();
+  result.color_viewpoints_corrected = size_t(std::count_if(
+      colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
 
   auto t = Clock::now();
   const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
@@ -328,11 +501,13 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
   result.gather = gather_samples(
       mesh, input.rasters, lights, masks, settings.gather, photos,
-      [&](const SampleChunk &chunk) {
+      [&](SampleChunk &chunk) {
+        if (correct) correct_colors(colors, chunk);
         consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
       },
       gather_progress);
   result.seconds_gather = seconds_since(t);
+  result.colors = std::move(colors.viewpoints);
 
   t = Clock::now();
   build_outputs(input, settings, result);

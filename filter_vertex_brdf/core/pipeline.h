@@ -1,6 +1,7 @@
 #pragma once
-// The whole filter without MeshLab: project -> lights -> visibility -> samples -> diffuse colour
-// and Phong fit (per vertex chunk) -> outputs. The plugin and the command-line tool both call this; they only differ in how they
+// The whole filter without MeshLab: project -> lights -> colour calibration (per viewpoint, from a
+// ColorChecker in the photos) -> visibility -> samples (colour-corrected) -> diffuse colour and
+// Phong fit (per vertex chunk) -> outputs. The plugin and the command-line tool both call this; they only differ in how they
 // obtain the mesh, the rasters and the GL context.
 #include <array>
 #include <functional>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "color_chart.h"
 #include "diffuse_color.h"
 #include "phong_fit.h"
 #include "mesh_view.h"
@@ -22,6 +24,8 @@ using LogFn = std::function<void(const std::string &line)>;
 enum class VisibilityChoice { Auto = 0, GL = 1, CPU = 2 };
 enum class FitBackendChoice { Auto = 0, GPU = 1, CPU = 2 };
 enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
+// Off: samples as decoded; Auto: corrected where a chart is found; Required: no chart is an error.
+enum class ColorCorrectionChoice { Off = 0, Auto = 1, Required = 2 };
 
 struct FitSettings {
   GatherSettings gather;
@@ -31,6 +35,12 @@ struct FitSettings {
   PhongFitOptions phong;               // its specular_threshold is taken from gather
   FitBackendChoice fit_backend = FitBackendChoice::Auto;
   QualityOutput quality = QualityOutput::DQ;  // what goes into vertex quality
+  ColorCorrectionChoice color_correction = ColorCorrectionChoice::Auto;
+  // Centres of the chart's corner patches (dark skin, bluish green, black, white; x y each, image
+  // pixels) in the first photo of a viewpoint: empty = detect; 8 numbers = the same for every
+  // viewpoint; 8 per viewpoint = one group each, viewpoints in order of their first raster.
+  std::vector<float> chart_corners;
+  ExposureMode exposure = ExposureMode::Auto;  // per-photo normalisation by the chart's neutrals
   std::string light_file;   // "" = search beside the project, then beside the images
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
 };
@@ -50,6 +60,10 @@ struct FitInput {
 std::vector<std::array<float, 3>> resolve_light_directions(const std::vector<Raster> &rasters,
                                                            const std::string &lp_path);
 
+// Rasters grouped by viewpoint: photos of one viewpoint share one registration (an identical shot,
+// equal to 1e-6 relative). Groups are in order of their first raster; indices ascending.
+std::vector<std::vector<size_t>> rasters_by_viewpoint(const std::vector<Raster> &rasters);
+
 // Checks everything that can be checked before any work: non-empty mesh with normals, at least
 // one raster, every raster with a valid shot and an existing photo of the shot's size.
 // Throws InputError with a message naming the item and the fix.
@@ -67,6 +81,8 @@ struct FitResult {
   size_t fit_full = 0, fit_diffuse_only = 0, fit_none = 0, fit_converged = 0, fit_iterations = 0;
   double seconds_fit = 0;
   std::string light_file;                 // the .lp used
+  std::vector<ColorCalibration> colors;   // per viewpoint (rasters_by_viewpoint order); empty when Off
+  size_t color_viewpoints_corrected = 0;
   std::string output_ply;                 // where the PLY was written
   std::string report;                     // human-readable report (also written beside the PLY)
   size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;

@@ -156,7 +156,7 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
                            const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
                            const GatherSettings &settings, PhotoCache &photos,
-                           const std::function<void(const SampleChunk &)> &consume, const ProgressFn &progress) {
+                           const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress) {
   const auto start = std::chrono::steady_clock::now();
   if (rasters.size() > 65535) throw InputError("More than 65535 photos in one project are not supported.");
   GatherStats stats;

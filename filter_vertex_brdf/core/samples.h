@@ -113,12 +113,13 @@ struct GatherStats {
 };
 
 // Streams samples chunk by chunk (vertex ranges sized by settings.chunk_sample_bytes) to
-// `consume`. Chunks arrive in vertex order; the chunk object is reused after `consume` returns.
+// `consume`. Chunks arrive in vertex order; the chunk object is reused after `consume` returns,
+// so `consume` may modify it (the fit corrects the samples' colours in place).
 // Only pairs the masks mark as seen are sampled; a photo that sees no vertex of a chunk is not
 // even loaded (GatherStats::rasters_skipped counts such raster x chunk pairs).
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
                            const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
                            const GatherSettings &settings, PhotoCache &photos,
-                           const std::function<void(const SampleChunk &)> &consume, const ProgressFn &progress = {});
+                           const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress = {});
 
 } // namespace vbrdf

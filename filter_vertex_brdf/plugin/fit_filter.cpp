@@ -1,5 +1,6 @@
 #include "fit_filter.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -27,9 +28,41 @@ const char *const kInitialShininess = "initialShininess";
 const char *const kMaxIterations = "maxIterations";
 const char *const kMinSpecularSamples = "minSpecularSamples";
 const char *const kQualityOutput = "qualityOutput";
+const char *const kColorCorrection = "colorCorrection";
+const char *const kChartCorners = "chartCorners";
+const char *const kExposureNormalisation = "exposureNormalisation";
 
 void require(bool ok, const char *param, const std::string &what) {
   if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
+}
+
+// "x1 y1 ... x4 y4" (spaces, commas or semicolons between numbers), 8 per viewpoint; "" = detect.
+std::vector<float> parse_corners(const QString &text) {
+  QString cleaned = text;
+  cleaned.replace(',', ' ').replace(';', ' ');
+  std::vector<float> values;
+  for (const QString &word : cleaned.split(' ', QString::SkipEmptyParts)) {
+    bool ok = false;
+    const float v = word.toFloat(&ok);
+    require(ok && std::isfinite(v), kChartCorners,
+            "must be numbers (x y of the dark skin, bluish green, black and white patch centres); '" +
+                word.toStdString() + "' is not a number");
+    values.push_back(v);
+  }
+  require(values.size() % 8 == 0, kChartCorners,
+          "needs 8 numbers per viewpoint (x y of 4 patch centres), got " + std::to_string(values.size()));
+  return values;
+}
+
+std::string color_summary(const vbrdf::FitSettings &settings, const vbrdf::FitResult &result) {
+  if (settings.color_correction == vbrdf::ColorCorrectionChoice::Off) return "off";
+  if (result.color_viewpoints_corrected == 0) {
+    const bool located = std::any_of(result.colors.begin(), result.colors.end(),
+                                     [](const vbrdf::ColorCalibration &c) { return !c.patches.empty(); });
+    return located ? "chart not usable, colours uncorrected" : "no chart found, colours uncorrected";
+  }
+  return std::to_string(result.color_viewpoints_corrected) + " of " + std::to_string(result.colors.size()) +
+         " viewpoint(s) corrected from the chart";
 }
 
 } // namespace
@@ -56,7 +89,13 @@ QString FitFilter::info() const {
          "n_visible, n_diffuse, n_specular, coloured, ...) and written with the geometry to a PLY, plus a text "
          "report beside it. The mesh geometry is not changed. The mesh needs per-vertex normals; photos "
          "must be undistorted.<br><br>"
-         "Reflectance is known up to one global scale (unknown light intensity and exposure).";
+         "Colour correction: when a 24-patch ColorChecker is in the photos of a viewpoint (detected, or "
+         "located by its corner patches), a colour correction fitted to the chart (3x3 matrix, tone curve + "
+         "matrix or per-channel polynomial, whichever predicts held-out patches best) is applied to every "
+         "sample in linear space before the fit, and the photos' exposure is normalised by the chart's neutral "
+         "patches (per photo when the light intensity varies). The albedo is then a reflectance in linear sRGB "
+         "without the camera's colour cast. Without a chart the reflectance is known up to one global scale "
+         "(unknown light intensity and exposure) and the camera's colours.";
 }
 
 MeshFilterInterface::FilterClass FitFilter::filterClass() const {
@@ -134,6 +173,26 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "What is stored in vertex quality, for Render > Color > Per Vertex Quality: the "
                            "thesis's diffuse or specular quality (0..2, higher is better) or the weighted "
                            "fit RMSE (lower is better)."));
+  params.addParam(RichEnum(kColorCorrection, 1, QStringList() << "Off" << "Auto (use a chart if found)" << "Required",
+                           "Colour correction",
+                           "Correct the photos' colours and exposure from a 24-patch ColorChecker (Classic, Mini, "
+                           "Passport) visible in the photos of each viewpoint, in linear space, before the fit. "
+                           "Auto: viewpoints whose photos show a chart are corrected, the others are fitted "
+                           "uncorrected (the log says which). Required: a viewpoint without a usable chart is an "
+                           "error. Off: photos are used as decoded."));
+  params.addParam(RichString(kChartCorners, "", "Chart corner patches (px)",
+                             "Only if the chart is not detected: centres of the chart's four corner patches in the "
+                             "first photo of the viewpoint, in image pixels (x right, y down from the top-left "
+                             "corner), in the order dark skin, bluish green, black, white: \"x1 y1 x2 y2 x3 y3 x4 "
+                             "y4\". Several viewpoints: 8 numbers for all, or 8 per viewpoint in raster order. "
+                             "Empty: detect the chart automatically."));
+  params.addParam(RichEnum(kExposureNormalisation, 0,
+                           QStringList() << "Auto" << "Off (one exposure)" << "On (each photo by its chart)",
+                           "Exposure normalisation",
+                           "With colour correction: how the photos' brightness is normalised by the chart's grey "
+                           "patches. Auto: one exposure for all photos when the chart's brightness follows its "
+                           "angle to the light (constant light intensity), else each photo by its own chart "
+                           "(varying intensity, e.g. a hand-held flash). On: always per photo. Off: never."));
 }
 
 vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
@@ -167,6 +226,10 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(min_specular >= 1 && min_specular <= 1000, kMinSpecularSamples, "must be in [1, 1000]");
   const int quality = params.getEnum(kQualityOutput);
   require(quality >= 0 && quality <= 2, kQualityOutput, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
+  const int color = params.getEnum(kColorCorrection);
+  require(color >= 0 && color <= 2, kColorCorrection, "must be 0 (Off), 1 (Auto) or 2 (Required)");
+  const int exposure = params.getEnum(kExposureNormalisation);
+  require(exposure >= 0 && exposure <= 2, kExposureNormalisation, "must be 0 (Auto), 1 (Off) or 2 (On)");
 
   s.gather.specular_threshold = specular;
   s.gather.diffuse_threshold = diffuse;
@@ -182,6 +245,9 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.phong.max_iterations = iterations;
   s.phong.min_specular_samples = min_specular;
   s.quality = vbrdf::QualityOutput(quality);
+  s.color_correction = vbrdf::ColorCorrectionChoice(color);  // same order as the enum's entries
+  s.chart_corners = parse_corners(params.getString(kChartCorners));
+  s.exposure = vbrdf::ExposureMode(exposure);               // same order as the enum's entries
   return s;
 }
 
@@ -231,7 +297,7 @@ void FitFilter::apply(FilterRun &run) const {
           << " seen but without usable sample; " << result.fit_full << " full Phong fits, " << result.fit_diffuse_only
           << " diffuse-only (visibility: " << result.visibility_backend << ", fit: "
           << (result.fit_backend.empty() ? std::string("off") : result.fit_backend) << ", lights: " << result.light_file
-          << "). Wrote " << result.output_ply;
+          << ", colour correction: " << color_summary(settings, result) << "). Wrote " << result.output_ply;
   log(summary.str());
 }
 

@@ -132,11 +132,12 @@ class ScriptTest(unittest.TestCase):
                  "visibilityBackend": "RichEnum", "depthTolerance": "RichFloat", "shadowMapSize": "RichInt",
                  "memoryBudgetMB": "RichInt", "fitReflectance": "RichBool", "fitBackend": "RichEnum",
                  "initialShininess": "RichFloat", "maxIterations": "RichInt", "minSpecularSamples": "RichInt",
-                 "qualityOutput": "RichEnum"}
+                 "qualityOutput": "RichEnum", "colorCorrection": "RichEnum", "chartCorners": "RichString",
+                 "exposureNormalisation": "RichEnum"}
         self.assertEqual({n: p.get("type") for n, p in params.items()}, types)
         # Attributes MeshLab's reader needs, or it silently drops the parameter.
         self.assertEqual(params["lightFile"].get("exts_cardinality"), "1")
-        for name in ("photoEncoding", "visibilityBackend"):
+        for name in ("photoEncoding", "visibilityBackend", "colorCorrection", "exposureNormalisation"):
             self.assertEqual(params[name].get("enum_cardinality"), "3")
 
     def test_write_mlx_sets_values(self):

@@ -1,0 +1,377 @@
+#include "sphere_filter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <memory>
+
+#include <QDir>
+#include <QFileInfo>
+
+#include "core/camera.h"
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/light_file.h"
+#include "core/photo.h"
+#include "core/pipeline.h"
+#include "core/sphere_lights.h"
+#include "meshlab_bridge.h"
+
+namespace vbrdf_plugin {
+
+namespace {
+
+// Parameter names: the .mlx scripts refer to them, never rename. The first sphere's names are
+// those of "Vertex BRDF: import new photos of a viewpoint".
+const char *const kViewpointRaster = "viewpointRaster";
+const char *const kSphereX = "sphereCenterX";
+const char *const kSphereY = "sphereCenterY";
+const char *const kSphereRadius = "sphereRadius";
+const char *const kSphere2X = "sphere2CenterX";
+const char *const kSphere2Y = "sphere2CenterY";
+const char *const kSphere2Radius = "sphere2Radius";
+const char *const kSphereCount = "sphereCount";
+const char *const kSphereRadiusWorld = "sphereRadiusWorld";
+const char *const kPhotoEncoding = "photoEncoding";
+const char *const kOutputLightFile = "outputLightFile";
+
+const char *const kPrefix = "Vertex BRDF sphere: ";
+const char *const kFitFilterName = "Vertex BRDF: fit per-vertex reflectance";
+
+std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
+
+void require(bool ok, const char *param, const std::string &what) {
+  if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
+}
+
+std::string fmt(const char *format, double a, double b = 0, double c = 0, double d = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, format, a, b, c, d);
+  return buf;
+}
+
+std::string canonical(const std::string &path) {
+  const QFileInfo info(QString::fromStdString(path));
+  return utf8(info.exists() ? info.canonicalFilePath() : info.absoluteFilePath());
+}
+
+struct SphereParams {
+  int viewpoint_raster = -1;
+  std::vector<vbrdf::SphereCircle> manual;  // empty: detect
+  int sphere_count = 1;
+  double radius_world = 0;
+  vbrdf::PhotoEncoding encoding = vbrdf::PhotoEncoding::Auto;
+  std::string output;  // as given (resolved later)
+};
+
+// A manual outline: used when its radius is set (> 0).
+bool manual_circle(const RichParameterList &params, const char *x, const char *y, const char *r,
+                   vbrdf::SphereCircle &out) {
+  out = {params.getFloat(x), params.getFloat(y), params.getFloat(r)};
+  require(std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.r) && out.r >= 0, r,
+          "must be 0 (find the sphere automatically) or the sphere's radius in pixels");
+  return out.r > 0;
+}
+
+SphereParams params_from(const RichParameterList &params) {
+  SphereParams p;
+  p.viewpoint_raster = params.getInt(kViewpointRaster);
+  require(p.viewpoint_raster >= -1, kViewpointRaster, "must be -1 (the current raster) or a raster index");
+  vbrdf::SphereCircle first, second;
+  const bool has_first = manual_circle(params, kSphereX, kSphereY, kSphereRadius, first);
+  const bool has_second = manual_circle(params, kSphere2X, kSphere2Y, kSphere2Radius, second);
+  require(has_first || !has_second, kSphereRadius,
+          "must be set when the second sphere is given (set the first sphere's centre and radius too)");
+  if (has_first) p.manual.push_back(first);
+  if (has_second) p.manual.push_back(second);
+  p.sphere_count = params.getInt(kSphereCount);
+  require(p.sphere_count >= 1 && p.sphere_count <= 4, kSphereCount, "must be in [1, 4]");
+  p.radius_world = params.getFloat(kSphereRadiusWorld);
+  require(std::isfinite(p.radius_world) && p.radius_world >= 0, kSphereRadiusWorld,
+          "must be 0 (unknown) or the spheres' radius in the mesh's units");
+  const int encoding = params.getEnum(kPhotoEncoding);
+  require(encoding >= 0 && encoding <= 2, kPhotoEncoding, "must be 0 (Auto), 1 (sRGB) or 2 (Linear)");
+  p.encoding = vbrdf::PhotoEncoding(encoding);  // same order as the enum's entries
+  p.output = utf8(params.getSaveFileName(kOutputLightFile));
+  return p;
+}
+
+// The raster chosen by the parameter; -1: MeshLab's current raster (else the last one).
+size_t chosen_raster(MeshDocument &document, int param) {
+  const int count = document.rasterList.size();
+  if (param >= 0) {
+    require(param < count, kViewpointRaster,
+            "is " + std::to_string(param) + " but the project has " + std::to_string(count) +
+                " rasters (counted from 0; -1 = the current raster)");
+    return size_t(param);
+  }
+  const int current = document.rasterList.indexOf(document.rm());
+  return size_t(current >= 0 ? current : count - 1);
+}
+
+std::vector<size_t> viewpoint_of(const std::vector<vbrdf::Raster> &rasters, size_t raster) {
+  for (const std::vector<size_t> &group : vbrdf::rasters_by_viewpoint(rasters))
+    if (std::find(group.begin(), group.end(), raster) != group.end()) return group;
+  return {raster};
+}
+
+// Mean of the linear channels (sphere_lights.h's grey image), through the photo's own table so
+// that the chosen encoding applies.
+template <typename T>
+cv::Mat gray_of(const vbrdf::Photo &photo) {
+  cv::Mat out(photo.pixels.size(), CV_32FC1);
+  for (int y = 0; y < out.rows; ++y) {
+    const T *in = photo.pixels.ptr<T>(y);
+    float *o = out.ptr<float>(y);
+    for (int x = 0; x < out.cols; ++x)
+      o[x] = (photo.lut[in[3 * x]] + photo.lut[in[3 * x + 1]] + photo.lut[in[3 * x + 2]]) / 3.0f;
+  }
+  return out;
+}
+
+// Loads photo i of the viewpoint on demand (detection reads each photo once or twice, the
+// highlights once more); reports progress and honours cancellation.
+vbrdf::GrayLoader gray_loader(const std::vector<vbrdf::Raster> &rasters, const std::vector<size_t> &group,
+                              const SphereParams &p, const vbrdf::ProgressFn &progress) {
+  const size_t expected = (p.manual.empty() ? 3 : 1) * group.size();
+  auto loads = std::make_shared<size_t>(0);
+  return [&rasters, &group, &p, progress, expected, loads](size_t i) {
+    const vbrdf::Raster &r = rasters[group.at(i)];
+    const float fraction = std::min(0.95f, float(++*loads) / float(std::max<size_t>(1, expected)));
+    if (progress && !progress(fraction, "finding the sphere and its highlights"))
+      throw vbrdf::ProcessingError("cancelled");
+    const vbrdf::Photo photo = vbrdf::load_photo(r.image_path, p.encoding, 0.99f, r.width(), r.height());
+    return photo.pixels.depth() == CV_16U ? gray_of<uint16_t>(photo) : gray_of<uint8_t>(photo);
+  };
+}
+
+std::string default_output(const std::string &project) {
+  const QFileInfo info(QString::fromStdString(project.empty() ? std::string("vertex_brdf") : project));
+  return utf8(QDir(info.absolutePath()).filePath(info.completeBaseName() + "_sphere.lp"));
+}
+
+// The output must not replace the project, the mesh or a photo.
+void check_output(const std::string &out, const std::string &project, const MeshModel *mesh,
+                  const std::vector<vbrdf::Raster> &rasters) {
+  std::vector<std::string> inputs = {project};
+  if (mesh != nullptr) inputs.push_back(utf8(mesh->fullName()));
+  for (const vbrdf::Raster &r : rasters) inputs.push_back(r.image_path);
+  const std::string target = canonical(out);
+  for (const std::string &in : inputs)
+    if (!in.empty() && canonical(in) == target)
+      throw vbrdf::InputError("Parameter '" + std::string(kOutputLightFile) + "' names the input file '" + in +
+                              "': choose another .lp path so that the input stays untouched.");
+}
+
+// Entries of an existing output .lp for rasters of other viewpoints, by raster index: running the
+// filter once per viewpoint builds one .lp for the whole project.
+std::map<size_t, vbrdf::LightEntry> other_viewpoint_entries(const std::string &out,
+                                                            const std::vector<vbrdf::Raster> &rasters,
+                                                            const std::vector<size_t> &group,
+                                                            const std::function<void(const std::string &)> &log) {
+  std::map<size_t, vbrdf::LightEntry> kept;
+  if (!vbrdf::file_exists(out)) return kept;
+  std::vector<vbrdf::LightEntry> existing;
+  try {
+    existing = vbrdf::read_light_file(out);
+  } catch (const vbrdf::InputError &e) {
+    log(std::string(kPrefix) + "the existing '" + out + "' is not a valid .lp (" + e.what() + "); it is replaced.");
+    return kept;
+  }
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    if (std::find(group.begin(), group.end(), r) != group.end()) continue;
+    const int i = vbrdf::find_light_for_image(existing, rasters[r].image_path);
+    if (i >= 0) kept[r] = existing[size_t(i)];
+  }
+  return kept;
+}
+
+// Near-light positions: camera frame -> world (a MeshLab shot is rigid, so world units once the
+// sphere radius is known in world units).
+void log_positions(const vbrdf::LightCalibration &cal, const std::vector<vbrdf::Raster> &rasters,
+                   const std::vector<size_t> &group, double radius_world,
+                   const std::function<void(const std::string &)> &log) {
+  for (size_t i = 0; i < cal.photos.size(); ++i) {
+    const vbrdf::PhotoLight &pl = cal.photos[i];
+    if (!pl.has_position) continue;
+    const vbrdf::Raster &r = rasters[group[i]];
+    const std::string name = "raster '" + r.label + "'";
+    if (radius_world <= 0) {
+      log(std::string(kPrefix) + name +
+          fmt(": near light at (%.3f, %.3f, %.3f) sphere radii in the camera frame (RMS miss %.3f); set "
+              "'sphereRadiusWorld' for world coordinates.",
+              pl.position[0], pl.position[1], pl.position[2], pl.position_rms));
+      continue;
+    }
+    const float p[3] = {float(pl.position[0]), float(pl.position[1]), float(pl.position[2])};
+    const float length = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    float dir[3], centre[3];
+    vbrdf::camera_to_world_direction(r.shot, p, dir);
+    vbrdf::camera_centre(r.shot, centre);
+    log(std::string(kPrefix) + name +
+        fmt(": near light at world (%.4f, %.4f, %.4f), RMS miss %.4f.", centre[0] + length * dir[0],
+            centre[1] + length * dir[1], centre[2] + length * dir[2], pl.position_rms));
+  }
+}
+
+// Image name as written in the .lp: relative to its folder when the photo is inside it (as
+// RTIBuilder and Relight resolve them), else the absolute path.
+std::string lp_image_name(const QDir &folder, const std::string &image) {
+  const QString relative = folder.relativeFilePath(QString::fromStdString(image));
+  if (relative.startsWith("../")) return utf8(QFileInfo(QString::fromStdString(image)).absoluteFilePath());
+  return utf8(relative);
+}
+
+// The .lp lines: this viewpoint's lights and the kept entries of other viewpoints, in raster order.
+std::vector<vbrdf::LightEntry> lp_entries(const vbrdf::LightCalibration &cal, const std::vector<vbrdf::Raster> &rasters,
+                                          const std::vector<size_t> &group,
+                                          std::map<size_t, vbrdf::LightEntry> entries, const std::string &out) {
+  const QDir folder = QFileInfo(QString::fromStdString(out)).absoluteDir();
+  for (size_t i = 0; i < group.size(); ++i) {
+    const vbrdf::PhotoLight &pl = cal.photos[i];
+    if (!pl.valid) continue;
+    vbrdf::LightEntry e;
+    e.image = lp_image_name(folder, rasters[group[i]].image_path);
+    for (int c = 0; c < 3; ++c) e.dir_cam[c] = float(pl.dir[c]);
+    entries[group[i]] = e;
+  }
+  std::vector<vbrdf::LightEntry> out_entries;
+  for (const auto &kv : entries) out_entries.push_back(kv.second);
+  return out_entries;
+}
+
+void validate_viewpoint(const std::vector<vbrdf::Raster> &rasters, const std::vector<size_t> &group) {
+  for (size_t r : group) {
+    if (!vbrdf::shot_is_valid(rasters[r].shot))
+      throw vbrdf::InputError("Raster '" + rasters[r].label + "' has no valid camera: register it to the mesh first.");
+    if (!vbrdf::file_exists(rasters[r].image_path))
+      throw vbrdf::InputError("Raster '" + rasters[r].label + "': photo '" + rasters[r].image_path +
+                              "' is missing. Restore the file or fix the path in the project.");
+  }
+}
+
+// Spheres and per-photo lights of the viewpoint, logged; InputError when no photo got a light.
+vbrdf::LightCalibration calibrate(const std::vector<vbrdf::Raster> &rasters, const std::vector<size_t> &group,
+                                  size_t chosen, const SphereParams &p, const vbrdf::ProgressFn &progress,
+                                  const std::function<void(const std::string &)> &log) {
+  vbrdf::LightSettings settings;
+  settings.manual_spheres = p.manual;
+  settings.search.max_spheres = p.sphere_count;
+  settings.sphere_radius_world = p.radius_world;
+  std::vector<std::string> names;
+  for (size_t r : group) names.push_back(rasters[r].label);  // the core quotes them
+  const vbrdf::SphereCamera camera = vbrdf::camera_from_shot(rasters[chosen].shot);
+  const vbrdf::LightCalibration cal =
+      vbrdf::calibrate_lights(group.size(), gray_loader(rasters, group, p, progress), camera, settings, names);
+  for (const std::string &line : cal.log) log(kPrefix + line);
+  log_positions(cal, rasters, group, p.radius_world, log);
+  if (cal.valid_count() == 0)
+    throw vbrdf::InputError("No photo of the viewpoint of raster '" + rasters[chosen].label +
+                            "' got a light: the sphere shows no highlight (see the warnings). Check the sphere's "
+                            "centre and radius (parameters '" + kSphereX + "', '" + kSphereY + "', '" +
+                            kSphereRadius + "'); nothing was written.");
+  return cal;
+}
+
+} // namespace
+
+QString SphereFilter::name() const { return "Vertex BRDF: estimate light directions from a reflective sphere"; }
+
+QString SphereFilter::info() const {
+  return "Estimates the light direction of every photo of one viewpoint (the rasters that share the chosen "
+         "raster's camera) from the highlight on a mirror sphere (chrome or black glass ball) visible in the "
+         "photos, and writes them to an <i>.lp</i> file (RTIBuilder/Relight format) for \"Vertex BRDF: fit "
+         "per-vertex reflectance\" (its <i>lightFile</i> parameter).<br><br>"
+         "The sphere is found automatically (circles in the median and maximum images, the track of the "
+         "highlights over the photos), or given by its centre and radius in image pixels of the photos (x right, "
+         "y down from the top-left corner, as in any image viewer); the log says which method found it. The "
+         "light is the mirror reflection of the camera ray through the highlight, with the perspective of the "
+         "raster's camera. A photo whose sphere is in shadow or shows no highlight gets no light (the log names "
+         "it).<br><br>"
+         "With two or more spheres the log reports how much their directions disagree (a near light) and, for "
+         "photos where they disagree by more than a degree, the triangulated light position (in world units "
+         "when the spheres' radius in world units is given). Entries of other viewpoints already in the output "
+         ".lp are kept, so running the filter once per viewpoint builds one .lp for the project. The mesh and "
+         "the project are not changed.";
+}
+
+MeshFilterInterface::FilterClass SphereFilter::filterClass() const { return MeshFilterInterface::Camera; }
+
+int SphereFilter::postConditions() const { return MeshModel::MM_NONE; }
+
+void SphereFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
+  params.addParam(RichInt(kViewpointRaster, -1, "Viewpoint raster",
+                          "Lights are estimated for the photos of this raster's viewpoint (every raster with the "
+                          "same camera), counted from 0 in the layer list; -1: the current raster."));
+  params.addParam(RichFloat(kSphereX, 0.0f, "Sphere centre x (px)",
+                            "Centre of the sphere's outline in the photos, image pixels from the left edge. Used "
+                            "with the radius below; radius 0: the sphere is found automatically."));
+  params.addParam(RichFloat(kSphereY, 0.0f, "Sphere centre y (px)",
+                            "Centre of the sphere's outline, image pixels from the top edge."));
+  params.addParam(RichFloat(kSphereRadius, 0.0f, "Sphere radius (px)",
+                            "Radius of the sphere's outline in image pixels. 0: find the sphere(s) automatically; "
+                            "> 0: use this outline (and the second sphere's, if set) and skip detection."));
+  params.addParam(RichFloat(kSphere2X, 0.0f, "Second sphere centre x (px)",
+                            "Optional second sphere (needs the first one set): centre x in image pixels."));
+  params.addParam(RichFloat(kSphere2Y, 0.0f, "Second sphere centre y (px)",
+                            "Second sphere: centre y in image pixels from the top edge."));
+  params.addParam(RichFloat(kSphere2Radius, 0.0f, "Second sphere radius (px)",
+                            "Second sphere: radius in image pixels; 0: no second sphere given."));
+  params.addParam(RichInt(kSphereCount, 1, "Spheres to find",
+                          "Automatic detection only: how many spheres to look for (1 to 4). With two or more, "
+                          "each photo's light is the mean of the spheres' directions and the log reports their "
+                          "disagreement and the near-light position."));
+  params.addParam(RichFloat(kSphereRadiusWorld, 0.0f, "Sphere radius (world units)",
+                            "Physical radius of the spheres in the mesh's units (all spheres the same size). "
+                            "Only for triangulated near-light positions: given, they are logged in world "
+                            "coordinates; 0: in sphere radii, camera frame."));
+  params.addParam(RichEnum(kPhotoEncoding, 0, QStringList() << "Auto" << "sRGB (8-bit)" << "Linear",
+                           "Photo encoding",
+                           "How photo values map to light. Auto: 8-bit photos are sRGB-encoded, 16-bit photos "
+                           "linear."));
+  params.addParam(RichSaveFile(
+      kOutputLightFile, "", "Light positions (*.lp)", "Output light file (.lp)",
+      "Where the light directions are written (RTI .lp: image name and unit direction towards the light, x right, "
+      "y up, z towards the camera), replacing the file atomically; entries of other viewpoints' rasters already "
+      "in it are kept. Relative paths are relative to the project folder. Empty: the project's name followed "
+      "by _sphere.lp, beside the project."));
+}
+
+void SphereFilter::apply(FilterRun &run) const {
+  const auto log = [&run](const std::string &line) {
+    const bool warning = line.find("Warning") != std::string::npos;
+    run.log(warning ? GLLogStream::WARNING : GLLogStream::FILTER, line);
+  };
+  const SphereParams p = params_from(run.params);
+  const std::vector<vbrdf::Raster> rasters = document_rasters(run.document);
+  if (rasters.empty())
+    throw vbrdf::InputError("The project has no rasters: load the registered photos of the viewpoint (File > Import "
+                            "Raster) or open the .mlp.");
+  const size_t chosen = chosen_raster(run.document, p.viewpoint_raster);
+  const std::vector<size_t> group = viewpoint_of(rasters, chosen);
+  validate_viewpoint(rasters, group);
+  const MeshModel *mesh = run.document.mm();
+  const std::string project = mesh != nullptr ? project_path(run.document, *mesh) : std::string();
+  std::string out = resolve_path(p.output, project);
+  if (out.empty()) out = default_output(project);
+  check_output(out, project, mesh, rasters);
+  log(std::string(kPrefix) + "viewpoint of raster '" + rasters[chosen].label + "': " + std::to_string(group.size()) +
+      " photo(s).");
+
+  const vbrdf::ProgressFn progress = progress_adapter(run.progress, kPrefix);
+  const vbrdf::LightCalibration cal = calibrate(rasters, group, chosen, p, progress, log);
+  const auto kept = other_viewpoint_entries(out, rasters, group, log);
+  vbrdf::write_light_file(out, lp_entries(cal, rasters, group, kept, out));
+  if (progress) progress(1.0f, "done");
+  log(std::string(kPrefix) + "wrote " + std::to_string(cal.valid_count()) + " light direction(s) to '" + out + "'" +
+      (kept.empty() ? std::string() : " (kept " + std::to_string(kept.size()) + " entries of other viewpoints)") +
+      ". To fit with them, set lightFile to '" + out + "' in \"" + kFitFilterName + "\".");
+  if (cal.valid_count() < group.size())
+    log(std::string(kPrefix) + "Warning: " + std::to_string(group.size() - cal.valid_count()) +
+        " photo(s) got no light and have no entry in the .lp: the fit will ask for them; remove those rasters or "
+        "give their lights by hand.");
+}
+
+} // namespace vbrdf_plugin
