@@ -4,13 +4,21 @@
 #include <string>
 
 #include "core/errors.h"
+#include "coverage_filter.h"
 #include "fit_filter.h"
+#include "import_photos_filter.h"
+#include "relight_filter.h"
+#include "sphere_filter.h"
 
 using vbrdf_plugin::PluginFilter;
 
 FilterVertexBrdfPlugin::FilterVertexBrdfPlugin() {
   // Order = FilterIDType: append new filters at the end.
   filters_.emplace_back(new vbrdf_plugin::FitFilter());
+  filters_.emplace_back(new vbrdf_plugin::RelightFilter());
+  filters_.emplace_back(new vbrdf_plugin::SphereFilter());
+  filters_.emplace_back(new vbrdf_plugin::CoverageFilter());
+  filters_.emplace_back(new vbrdf_plugin::ImportPhotosFilter());
 
   for (size_t id = 0; id < filters_.size(); ++id) {
     typeList << FilterIDType(id);

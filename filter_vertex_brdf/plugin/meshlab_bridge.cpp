@@ -191,4 +191,38 @@ vbrdf::ProgressFn progress_adapter(vcg::CallBackPos *cb, const std::string &pref
   };
 }
 
+// --- Acquisition feedback (coverage and photo import filters) ---
+
+std::vector<float> vertex_float_attribute(MeshModel &mesh, const MeshArrays &arrays, const std::string &name) {
+  using Alloc = vcg::tri::Allocator<CMeshO>;
+  CMeshO &cm = mesh.cm;
+  if (!vcg::tri::HasPerVertexAttribute(cm, name)) return {};
+  auto handle = Alloc::FindPerVertexAttribute<float>(cm, name);
+  if (!Alloc::IsValidHandle(cm, handle)) return {};  // same name, another type
+  std::vector<float> values(arrays.vertex_index.size());
+  for (size_t i = 0; i < values.size(); ++i) values[i] = handle[arrays.vertex_index[i]];
+  return values;
+}
+
+void select_vertices(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint32_t> &vertices) {
+  CMeshO &cm = mesh.cm;
+  for (CVertexO &v : cm.vert)
+    if (!v.IsD()) v.ClearS();
+  for (uint32_t i : vertices)
+    if (i < arrays.vertex_index.size()) cm.vert[arrays.vertex_index[i]].SetS();
+}
+
+void add_raster(MeshDocument &document, const std::string &image_path, const vbrdf::Shot &shot,
+                const std::string &label) {
+  const QString path = QString::fromStdString(image_path);
+  std::unique_ptr<Plane> plane(new Plane(path, Plane::RGBA));  // loads the image
+  if (plane->image.isNull())
+    throw vbrdf::InputError("Photo '" + image_path + "' cannot be read as an image (missing, unreadable or of an "
+                            "unsupported format): check the file.");
+  RasterModel *raster = document.addNewRaster();
+  raster->setLabel(QString::fromStdString(label));
+  raster->shot = shot;
+  raster->addPlane(plane.release());
+}
+
 } // namespace vbrdf_plugin

@@ -62,4 +62,20 @@ private:
 // callback processes Qt events).
 vbrdf::ProgressFn progress_adapter(vcg::CallBackPos *cb, const std::string &prefix);
 
+// --- Acquisition feedback (coverage and photo import filters) ---
+
+// Values of the float per-vertex attribute `name` (e.g. "dq", "sq" stored by the fit filter) for
+// the vertices of `arrays`, in array order; empty when the mesh has no such float attribute.
+std::vector<float> vertex_float_attribute(MeshModel &mesh, const MeshArrays &arrays, const std::string &name);
+
+// Selects exactly the given array vertices (indices into `arrays`); every other vertex is
+// deselected.
+void select_vertices(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint32_t> &vertices);
+
+// Appends a raster layer labelled `label` with `shot` and the photo `image_path` as its only
+// plane (as File > Import Raster does, without the EXIF guess). Throws vbrdf::InputError naming
+// the file when Qt cannot read the image; the document is unchanged then.
+void add_raster(MeshDocument &document, const std::string &image_path, const vbrdf::Shot &shot,
+                const std::string &label);
+
 } // namespace vbrdf_plugin

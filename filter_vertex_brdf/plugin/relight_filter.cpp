@@ -1,0 +1,351 @@
+#include "relight_filter.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <QDir>
+#include <QFileInfo>
+#include <vcg/complex/allocate.h>
+
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/light_file.h"
+#include "core/output_ply.h"
+#include "core/pipeline.h"
+#include "core/project.h"
+#include "core/relight_render.h"
+#include "core/result_ply.h"
+#include "meshlab_bridge.h"
+
+namespace vbrdf_plugin {
+
+namespace {
+
+// Parameter names: the .mlx scripts refer to them, never rename.
+const char *const kFitResultPly = "fitResultPly";
+const char *const kRasterProject = "rasterProject";
+const char *const kLightFile = "lightFile";
+const char *const kOutputFolder = "outputFolder";
+const char *const kRenderRasters = "renderRasters";
+const char *const kNovelView = "novelView";
+const char *const kViewRaster = "viewRaster";
+const char *const kOrbitAzimuth = "orbitAzimuth";
+const char *const kOrbitElevation = "orbitElevation";
+const char *const kDistanceScale = "distanceScale";
+const char *const kNovelLight = "novelLight";
+const char *const kHeatMapMax = "heatMapMax";
+const char *const kPhotoEncoding = "photoEncoding";
+const char *const kShadowMapSize = "shadowMapSize";
+const char *const kColorCorrection = "colorCorrection";
+const char *const kChartCorners = "chartCorners";
+const char *const kExposureNormalisation = "exposureNormalisation";
+
+void require(bool ok, const char *param, const std::string &what) {
+  if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
+}
+
+std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
+
+// "x1 y1 ... x4 y4" (spaces, commas or semicolons between numbers), 8 per viewpoint; "" = detect.
+std::vector<float> parse_corners(const QString &text) {
+  QString cleaned = text;
+  cleaned.replace(',', ' ').replace(';', ' ');
+  std::vector<float> values;
+  for (const QString &word : cleaned.split(' ', QString::SkipEmptyParts)) {
+    bool ok = false;
+    const float v = word.toFloat(&ok);
+    require(ok && std::isfinite(v), kChartCorners, "must be numbers; '" + utf8(word) + "' is not a number");
+    values.push_back(v);
+  }
+  require(values.size() % 8 == 0, kChartCorners,
+          "needs 8 numbers per viewpoint (x y of 4 patch centres), got " + std::to_string(values.size()));
+  return values;
+}
+
+struct Settings {
+  std::string fit_result_ply, raster_project, light_file, output_folder;
+  bool render_rasters = true, novel_view = false;
+  int view_raster = 0;
+  float azimuth = 0, elevation = 0, distance_scale = 1;
+  float novel_light[3] = {0, 0, 1};
+  vbrdf::RelightRenderSettings render;
+  vbrdf::RelightOutputOptions output;
+};
+
+Settings settings_from(const RichParameterList &params) {
+  Settings s;
+  s.fit_result_ply = utf8(params.getOpenFileName(kFitResultPly));
+  s.raster_project = utf8(params.getOpenFileName(kRasterProject));
+  s.light_file = utf8(params.getOpenFileName(kLightFile));
+  s.output_folder = utf8(params.getString(kOutputFolder));
+  s.render_rasters = params.getBool(kRenderRasters);
+  s.novel_view = params.getBool(kNovelView);
+  require(s.render_rasters || s.novel_view, kRenderRasters, "and 'novelView' are both off: nothing to render");
+  s.view_raster = params.getInt(kViewRaster);
+  require(s.view_raster >= 0, kViewRaster, "must be a raster index (0 = the first raster)");
+  s.azimuth = params.getFloat(kOrbitAzimuth);
+  s.elevation = params.getFloat(kOrbitElevation);
+  require(std::isfinite(s.azimuth) && std::fabs(s.azimuth) <= 360, kOrbitAzimuth, "must be in [-360, 360] degrees");
+  require(std::isfinite(s.elevation) && std::fabs(s.elevation) <= 89, kOrbitElevation, "must be in [-89, 89] degrees");
+  s.distance_scale = params.getFloat(kDistanceScale);
+  require(std::isfinite(s.distance_scale) && s.distance_scale >= 0.05f && s.distance_scale <= 20, kDistanceScale,
+          "must be in [0.05, 20]");
+  const vcg::Point3f light = params.getPoint3f(kNovelLight);
+  require(std::isfinite(light.Norm()) && light.Norm() > 1e-6f, kNovelLight, "must be a non-zero direction");
+  for (int k = 0; k < 3; ++k) s.novel_light[k] = light[k] / light.Norm();
+  s.output.heat_map_max_de = params.getFloat(kHeatMapMax);
+  require(std::isfinite(s.output.heat_map_max_de) && s.output.heat_map_max_de > 0 && s.output.heat_map_max_de <= 100,
+          kHeatMapMax, "must be in (0, 100]");
+  const int encoding = params.getEnum(kPhotoEncoding);
+  require(encoding >= 0 && encoding <= 2, kPhotoEncoding, "must be 0 (Auto), 1 (sRGB) or 2 (Linear)");
+  s.output.encoding = vbrdf::PhotoEncoding(encoding);
+  const int color = params.getEnum(kColorCorrection);
+  require(color >= 0 && color <= 2, kColorCorrection, "must be 0 (Off), 1 (Auto) or 2 (Required)");
+  s.output.color_correction = vbrdf::RelightColorCorrection(color);  // same order as the enum's entries
+  s.output.chart_corners = parse_corners(params.getString(kChartCorners));
+  const int exposure = params.getEnum(kExposureNormalisation);
+  require(exposure >= 0 && exposure <= 2, kExposureNormalisation, "must be 0 (Auto), 1 (Off) or 2 (On)");
+  s.output.exposure = vbrdf::ExposureMode(exposure);  // same order as the enum's entries
+  s.render.shadow_map_size = params.getInt(kShadowMapSize);
+  require(s.render.shadow_map_size == 0 || (s.render.shadow_map_size >= 64 && s.render.shadow_map_size <= 16384),
+          kShadowMapSize, "must be 0 (automatic) or in [64, 16384]");
+  return s;
+}
+
+// The fit filter's per-vertex float attributes, in array order.
+std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays) {
+  using Alloc = vcg::tri::Allocator<CMeshO>;
+  const char *names[] = {"kd", "ks", "shininess", "color_r", "color_g", "color_b", "fit_status"};
+  std::vector<CMeshO::PerVertexAttributeHandle<float>> handles;
+  for (const char *name : names) {
+    auto h = Alloc::FindPerVertexAttribute<float>(mesh.cm, name);
+    if (!Alloc::IsValidHandle(mesh.cm, h))
+      throw vbrdf::InputError("Mesh '" + utf8(mesh.label()) + "' has no per-vertex '" + name +
+                              "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit Phong reflectance' on) "
+                              "first, or set 'fitResultPly' to the PLY it wrote.");
+    handles.push_back(h);
+  }
+  std::vector<vbrdf::VertexFit> fits(arrays.vertex_index.size());
+  for (size_t i = 0; i < fits.size(); ++i) {
+    const size_t v = arrays.vertex_index[i];
+    vbrdf::VertexFit &f = fits[i];
+    f.kd = handles[0][v], f.ks = handles[1][v], f.shininess = handles[2][v];
+    for (int c = 0; c < 3; ++c) f.color[c] = handles[3 + size_t(c)][v];
+    f.status = uint8_t(std::max(0.0f, std::min(2.0f, handles[6][v])));
+  }
+  return fits;
+}
+
+// Fits of a saved result PLY, which must be this mesh (same vertices in the same order).
+std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays) {
+  const vbrdf::ResultPly result = vbrdf::read_result_ply(path);
+  const std::vector<float> &p = arrays.data.positions, &q = result.mesh.positions;
+  const float tolerance = 1e-4f * std::max(1e-12f, vbrdf::compute_bounds(arrays.data.view()).diagonal());
+  bool same = p.size() == q.size();
+  for (size_t i = 0; same && i < p.size(); ++i) same = std::fabs(p[i] - q[i]) <= tolerance;
+  if (!same)
+    throw vbrdf::InputError("The fit result '" + path + "' has " + std::to_string(q.size() / 3) +
+                            " vertices that do not match the current mesh (" + std::to_string(p.size() / 3) +
+                            " vertices): choose the PLY the fit wrote for this mesh, or clear 'fitResultPly'.");
+  return vbrdf::fits_from_result(result, path);
+}
+
+struct RasterSet {
+  std::vector<vbrdf::Raster> rasters;
+  std::string project, light_file;
+};
+
+RasterSet rasters_to_render(const MeshDocument &document, const MeshModel &mesh, const Settings &s) {
+  RasterSet set;
+  if (!s.raster_project.empty()) {
+    set.project = resolve_path(s.raster_project, project_path(document, mesh));
+    set.rasters = vbrdf::read_project(set.project).rasters;
+  } else {
+    set.project = project_path(document, mesh);
+    set.rasters = document_rasters(document);
+  }
+  if (set.rasters.empty())
+    throw vbrdf::InputError("No raster to render: open the project with its photos, or set 'rasterProject' to an "
+                            ".mlp (e.g. the held-out photos' heldout/project.mlp).");
+  set.light_file = s.light_file.empty()
+                       ? vbrdf::find_default_light_file(set.project, set.rasters.front().image_path)
+                       : resolve_path(s.light_file, project_path(document, mesh));
+  return set;
+}
+
+std::string default_output_folder(const std::string &project) {
+  if (project.empty()) return utf8(QDir::current().absoluteFilePath("vertex_brdf_relight"));
+  const QFileInfo info(QString::fromStdString(project));
+  return utf8(info.absoluteDir().absoluteFilePath(info.completeBaseName() + "_relight"));
+}
+
+void log_report(const vbrdf::RelightReport &report, const std::function<void(const std::string &)> &log) {
+  char line[512];
+  for (const vbrdf::RelightRow &row : report.rows) {
+    const vbrdf::PixelComparison &c = row.comparison;
+    std::snprintf(line, sizeof line, "  %s: %zu lit pixels, CIEDE2000 mean %.2f, p95 %.2f, PSNR %.1f dB",
+                  row.label.c_str(), c.pixels, c.mean_de2000, c.p95_de2000, c.psnr_db);
+    log(line);
+  }
+  const vbrdf::PixelComparison &all = report.overall.comparison;
+  std::snprintf(line, sizeof line,
+                "Vertex BRDF relight: %zu rasters, %zu lit visible pixels: CIEDE2000 mean %.2f, p95 %.2f, PSNR %.1f dB",
+                report.rows.size(), all.pixels, all.mean_de2000, all.p95_de2000, all.psnr_db);
+  log(line);
+}
+
+void render_novel_view(vbrdf::RelightRenderer &renderer, const RasterSet &set, const vbrdf::MeshData &mesh,
+                       const Settings &s, std::vector<std::string> &files) {
+  if (size_t(s.view_raster) >= set.rasters.size())
+    throw vbrdf::InputError("Parameter 'viewRaster' is " + std::to_string(s.view_raster) + " but there are only " +
+                            std::to_string(set.rasters.size()) + " rasters (the first is 0).");
+  const vbrdf::Raster &base = set.rasters[size_t(s.view_raster)];
+  if (!vbrdf::shot_is_valid(base.shot))
+    throw vbrdf::InputError("Raster '" + base.label + "' has no valid camera: choose another 'viewRaster'.");
+  const vbrdf::Bounds b = vbrdf::compute_bounds(mesh.view());
+  const float pivot[3] = {0.5f * (b.min[0] + b.max[0]), 0.5f * (b.min[1] + b.max[1]), 0.5f * (b.min[2] + b.max[2])};
+  const vbrdf::Shot shot = vbrdf::orbit_shot(base.shot, pivot, s.azimuth, s.elevation, s.distance_scale);
+  float light_world[3];
+  vbrdf::camera_to_world_direction(shot, s.novel_light, light_world);
+  const vbrdf::RelitImage image = renderer.render(shot, light_world);
+  const std::string path = vbrdf::join_path(s.output_folder, "novel_view.png");
+  for (const vbrdf::Raster &r : set.rasters)
+    if (r.image_path == path)
+      throw vbrdf::InputError("'" + path + "' is the photo of raster '" + r.label + "': choose another output folder.");
+  if (!QDir().mkpath(QString::fromStdString(s.output_folder)))
+    throw vbrdf::ProcessingError("Cannot create the output folder '" + s.output_folder + "'.");
+  vbrdf::write_png_atomically(path, vbrdf::display_image(image));
+  files.push_back(path);
+}
+
+} // namespace
+
+QString RelightFilter::name() const { return "Vertex BRDF: relight and compare"; }
+
+QString RelightFilter::info() const {
+  return "Renders the per-vertex Phong reflectance fitted by <i>Vertex BRDF: fit per-vertex reflectance</i> "
+         "(f = k<sub>d</sub> (N&middot;L) C + k<sub>s</sub> (R&middot;E)<sup>&alpha;</sup>, evaluated per pixel "
+         "with interpolated normals and parameters, cast shadows from a shadow map, directional light of unit "
+         "irradiance as in the fit) with OpenGL, and compares it with the photos.<br><br>"
+         "<b>Every raster</b>: each raster's camera under its light (from the .lp). For each raster an image "
+         "<i>model | photo | CIEDE2000 heat map</i> is written, plus a contact sheet of all of them and a table "
+         "(relight_table.csv: mean, median and 95th-percentile CIEDE2000 and PSNR over the lit visible pixels: lit "
+         "in the render, not at a silhouette or depth jump, no clipped photo channel). Use 'Raster project' to "
+         "score photos the fit did not use (held-out lights), which measures how well the model relights.<br><br>"
+         "<b>Novel view</b>: the camera of one raster orbited around the mesh centre and moved closer or farther, "
+         "lit from a direction you give in that camera's frame (x right, y up, z towards the viewer, as in .lp "
+         "files); written as novel_view.png.<br><br>"
+         "Reads the per-vertex attributes the fit stored on the mesh (kd, ks, shininess, color_r/g/b, fit_status) "
+         "or a result PLY the fit wrote. Vertices without a fit are shown dark magenta. The mesh is not changed. "
+         "Needs OpenGL 3.3.";
+}
+
+MeshFilterInterface::FilterClass RelightFilter::filterClass() const {
+  return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::Measure);
+}
+
+int RelightFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
+
+int RelightFilter::postConditions() const { return MeshModel::MM_NONE; }
+
+void RelightFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
+  params.addParam(RichOpenFile(kFitResultPly, "", QStringList("PLY (*.ply)"), "Fit result (.ply)",
+                               "A PLY written by the fit filter for this mesh. Empty: the per-vertex attributes the "
+                               "fit stored on the current mesh in this session."));
+  params.addParam(RichOpenFile(kRasterProject, "", QStringList("MeshLab project (*.mlp)"), "Raster project (.mlp)",
+                               "Render the rasters of this project instead of the document's, e.g. the held-out "
+                               "photos (heldout/project.mlp) to measure relighting on lights the fit never saw. "
+                               "Its mesh is ignored; its cameras must be registered to the current mesh."));
+  params.addParam(RichOpenFile(kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
+                               "Light direction of each rendered raster (RTI .lp, matched by image file name). "
+                               "Empty: the first *.lp beside the project (or the raster project), else beside its "
+                               "first photo."));
+  params.addParam(RichString(kOutputFolder, "", "Output folder",
+                             "Where the images, contact_sheet.png and relight_table.csv are written (created if "
+                             "needed; existing files of the same names are replaced). Relative paths are relative "
+                             "to the project folder. Empty: <project name>_relight beside the project."));
+  params.addParam(RichBool(kRenderRasters, true, "Render every raster",
+                           "Render each raster's camera under its light and compare with its photo."));
+  params.addParam(RichBool(kNovelView, false, "Render a novel view",
+                           "Also render the camera of 'View raster' moved by the orbit parameters, under 'Novel "
+                           "light', into novel_view.png."));
+  params.addParam(RichInt(kViewRaster, 0, "View raster",
+                          "Index of the raster (0 = first) whose camera the novel view starts from."));
+  params.addParam(RichFloat(kOrbitAzimuth, 0.0f, "Orbit azimuth (deg)",
+                            "Turns the novel camera around the mesh centre about its up axis; positive moves it to "
+                            "its right. Range [-360, 360]."));
+  params.addParam(RichFloat(kOrbitElevation, 0.0f, "Orbit elevation (deg)",
+                            "Tilts the novel camera around the mesh centre about its right axis; positive moves it "
+                            "up. Range [-89, 89]."));
+  params.addParam(RichFloat(kDistanceScale, 1.0f, "Distance scale",
+                            "Multiplies the novel camera's distance to the mesh centre (below 1: closer). "
+                            "Range [0.05, 20]."));
+  params.addParam(RichPoint3f(kNovelLight, vcg::Point3f(0.0f, 0.0f, 1.0f), "Novel light direction",
+                              "Direction towards the light for the novel view, in that camera's frame: x right, y up, "
+                              "z towards the viewer (0 0 1 = a light behind the camera)."));
+  params.addParam(RichFloat(kHeatMapMax, 10.0f, "Heat map maximum (CIEDE2000)",
+                            "Colour difference shown at the top of the heat map's colour scale (larger values are "
+                            "clipped). 1 is about a just-noticeable difference. Range (0, 100]."));
+  params.addParam(RichEnum(kPhotoEncoding, 0, QStringList() << "Auto" << "sRGB (8-bit)" << "Linear",
+                           "Photo encoding",
+                           "How photo values map to light, as in the fit: Auto takes 8-bit photos as sRGB and "
+                           "16-bit photos as linear."));
+  params.addParam(RichEnum(kColorCorrection, 1, QStringList() << "Off" << "Auto (use a chart if found)" << "Required",
+                           "Colour correction",
+                           "Set it as for the fit. When the fit corrected its samples with a ColorChecker seen in "
+                           "the photos, its model predicts corrected colours: the compared photos are then "
+                           "calibrated from the chart in their own viewpoint and corrected the same way. Auto: "
+                           "viewpoints without a chart are compared as decoded. Off: never corrected."));
+  params.addParam(RichString(kChartCorners, "", "Chart corner patches (px)",
+                             "As for the fit, if the chart is not detected: centres of the dark skin, bluish green, "
+                             "black and white patches in the first photo of each rendered viewpoint, \"x1 y1 ... x4 "
+                             "y4\" (8 numbers for all viewpoints, or 8 per viewpoint). Empty: detect."));
+  params.addParam(RichEnum(kExposureNormalisation, 0,
+                           QStringList() << "Auto" << "Off (one exposure)" << "On (each photo by its chart)",
+                           "Exposure normalisation", "As for the fit: how the compared photos' brightness is "
+                           "normalised by the chart's grey patches."));
+  params.addParam(RichInt(kShadowMapSize, 0, "Shadow map size",
+                          "Resolution of the depth map rendered from the light for cast shadows. 0: automatic, as "
+                          "the fit's visibility pass (from the mesh's edge lengths). Otherwise [64, 16384]."));
+}
+
+void RelightFilter::apply(FilterRun &run) const {
+  MeshModel *mesh = run.document.mm();
+  if (mesh == nullptr) throw vbrdf::InputError("No current mesh: open the fitted mesh (or its .mlp project) first.");
+  const auto log = [&run](const std::string &line) { run.log(GLLogStream::FILTER, line); };
+  Settings s = settings_from(run.params);
+  const MeshArrays arrays = mesh_arrays(*mesh);
+  const std::string project = project_path(run.document, *mesh);
+  const std::vector<vbrdf::VertexFit> fits =
+      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays)
+                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays);
+  const RasterSet set = rasters_to_render(run.document, *mesh, s);
+  s.output_folder =
+      s.output_folder.empty() ? default_output_folder(set.project) : resolve_path(s.output_folder, project);
+  s.output.folder = s.output_folder;
+  std::vector<std::array<float, 3>> lights;
+  if (s.render_rasters) {
+    if (set.light_file.empty())
+      throw vbrdf::InputError("No light file (.lp) found beside '" + set.project +
+                              "' or its photos: set 'lightFile' to the .lp of the rendered rasters.");
+    lights = vbrdf::resolve_light_directions(set.rasters, set.light_file);
+  }
+
+  GlContextScope gl(run.gl_context, log);
+  if (!gl.get_proc())
+    throw vbrdf::ProcessingError("relighting needs OpenGL 3.3, and MeshLab gave no usable OpenGL context.");
+  vbrdf::RelightRenderer renderer(arrays.data.view(), fits, gl.get_proc(), s.render);
+  std::vector<std::string> files;
+  if (s.render_rasters) {
+    const vbrdf::RelightReport report = vbrdf::relight_rasters(renderer, set.rasters, lights, s.output,
+                                                               progress_adapter(run.progress, "Vertex BRDF: "));
+    for (const std::string &line : report.color_log) log("Vertex BRDF relight, colour correction: " + line);
+    log_report(report, log);
+    files = report.files;
+  }
+  if (s.novel_view) render_novel_view(renderer, set, arrays.data, s, files);
+  log("Vertex BRDF relight: wrote " + std::to_string(files.size()) + " files to " + s.output_folder +
+      " (OpenGL: " + renderer.renderer_name() + ").");
+}
+
+} // namespace vbrdf_plugin

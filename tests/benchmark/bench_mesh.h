@@ -1,0 +1,22 @@
+#pragma once
+// Mesh helpers of the benchmark: quadric-edge-collapse decimation (vcglib, as MeshLab's
+// "Simplification: Quadric Edge Collapse Decimation") and nearest-vertex transfer of per-vertex
+// ground truth onto a decimated mesh.
+#include <cstddef>
+#include <vector>
+
+#include "mesh_view.h"
+
+namespace vbrdf {
+namespace bench {
+
+// Decimates `in` to at most `target_vertices` vertices (quality threshold 0.3, boundaries kept,
+// no normal flips, optimal vertex placement), then recomputes area-weighted vertex normals.
+// Returns the input unchanged when it already has no more vertices than the target.
+MeshData decimate(const MeshData &in, size_t target_vertices);
+
+// For every vertex of `to`, the index of the nearest vertex of `from` (uniform grid, exact).
+std::vector<size_t> nearest_vertices(const MeshView &from, const MeshView &to);
+
+} // namespace bench
+} // namespace vbrdf

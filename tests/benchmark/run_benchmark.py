@@ -1,0 +1,424 @@
+#!/usr/bin/env python3
+"""Benchmark: run time against error of the Vertex BRDF fit (tests/benchmark/RESULTS.md).
+
+  run_benchmark.py --bench <build>/tests/benchmark/vbrdf_bench --synth <build>/tests/tools/synthesize_scene
+                   --work DIR --out DIR [--smoke] [--only SUBSTRING]
+
+Runs a grid of configurations with vbrdf_bench (the filter's pipeline without MeshLab, GL through
+OSMesa = llvmpipe here) and writes into --out:
+  results.csv              one row per configuration: wall time per stage and errors
+  time_vs_error.png        the synthetic 100k-vertex scene: total time against held-out relit
+                           CIEDE2000, Pareto front marked
+  time_vs_error_scenes.png the shared scenes and sample projects, one front per scene
+  summary.md               tables and the figures RESULTS.md quotes (knee, defaults, scaling)
+
+Grid (a one-factor-at-a-time design around a reference, not the full product: that would take
+hours on 2 cores). Reference: synthetic scene, mesh decimated to 100k vertices, 32 photos,
+iteration cap 20. Around it: back end {gpu, cpu} x iteration cap {1,2,5,10,20,50,400}; photos
+{4,8,16,32} x back end; mesh {10k, 100k, full = 300k} x back end; CPU visibility once. Synthetic
+configurations run twice (the reference three times) and keep the fastest run. Shared
+scenes (16-bit linear photos, no colour cast) and the sample projects: photos {4,8,16,all}, caps
+{1,5,20,50,400}, GPU at the defaults, mesh decimated to 10k. Every configuration is scored on the
+held-out lights (photos never used by the fit).
+
+Data (synthetic scene, decimated meshes) is generated once into --work and reused.
+Standard library only.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+sys.dont_write_bytecode = True
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
+SHARED = os.environ.get("VBRDF_SHARED_DIR", os.path.normpath(os.path.join(REPO, "..", "shared")))
+
+CAPS = [1, 2, 5, 10, 20, 50, 400]
+DEFAULT_CAP = 20
+SYNTH_ARGS = ["--vertices", "300000", "--width", "1024", "--height", "768", "--lights", "32", "--heldout", "8"]
+SMOKE_SYNTH_ARGS = ["--size", "tiny", "--width", "320", "--height", "240", "--lights", "6", "--heldout", "2"]
+SHARED_SCENES = ["spot_dir24", "bunny_two_materials_dir32", "teapot_dir16", "teapot_point16"]
+SAMPLE_PROJECTS = ["synth_basic", "synth_two_views", "synth_linear16"]
+
+CSV_COLUMNS = ["scene", "axis", "mesh", "vertices", "photos", "backend", "iterations",
+               "t_init", "t_prepare", "t_visibility", "t_gather", "t_fit", "t_output", "t_total",
+               "t_total_max", "relit_mean", "relit_median", "relit_p95", "relit_psnr", "relit_pixels",
+               "rho_de_mean", "rho_de_p95", "coverage",
+               "ks_rel_median", "alpha_rel_median", "glossy_determined", "full_fits", "converged",
+               "alpha_iterations", "samples", "repeats", "pareto"]
+
+
+class Project:
+    """One capture: training project, held-out project, ground truth and mesh variants."""
+
+    def __init__(self, name, mlp, heldout, gt=None, photo_dir="", heldout_photo_dir="", factors="",
+                 meshes=None, photos=0):
+        self.name, self.mlp, self.heldout, self.gt = name, mlp, heldout, gt
+        self.photo_dir, self.heldout_photo_dir, self.factors = photo_dir, heldout_photo_dir, factors
+        self.meshes = meshes or {"full": ""}  # label -> mesh path ("" = the project's own)
+        self.photos = photos                  # number of training photos
+
+
+def log(msg):
+    print(msg, flush=True)
+
+
+def run(cmd, quiet=True):
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"command failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stdout[-3000:]}")
+    if not quiet:
+        log(proc.stdout.strip())
+    return proc.stdout
+
+
+def count_rasters(mlp):
+    with open(mlp, encoding="utf-8") as f:
+        return f.read().count("<MLRaster")
+
+
+def mlp_vertices(ply):
+    with open(ply, "rb") as f:
+        for raw in f:
+            line = raw.decode("ascii", "replace").strip()
+            if line.startswith("element vertex"):
+                return int(line.split()[2])
+            if line == "end_header":
+                break
+    return 0
+
+
+# ---------------------------------------------------------------------------------------------
+# Data
+
+def synthesize(tools, out, args):
+    """Renders a synthetic project once; a stamp with the options makes later runs reuse it."""
+    stamp = os.path.join(out, ".bench_stamp")
+    want = " ".join(args)
+    if os.path.isfile(stamp) and open(stamp, encoding="utf-8").read() == want:
+        return
+    log(f"synthesizing {out} ({want}) ...")
+    start = time.time()
+    run([tools.synth, "--quiet", "--out", out] + args)
+    with open(stamp, "w", encoding="utf-8") as f:
+        f.write(want)
+    log(f"  done in {time.time() - start:.0f} s")
+
+
+def decimated(tools, mesh, out, vertices):
+    if not os.path.isfile(out) or os.path.getmtime(out) < os.path.getmtime(mesh):
+        os.makedirs(os.path.dirname(out), exist_ok=True)
+        log(f"decimating {mesh} to {vertices} vertices ...")
+        log("  " + run([tools.bench, "decimate", "--in", mesh, "--out", out, "--vertices", str(vertices)]).strip())
+    return out
+
+
+def synthetic_project(tools, work, smoke):
+    out = os.path.join(work, "data", "synth_tiny" if smoke else "synth_300k")
+    synthesize(tools, out, SMOKE_SYNTH_ARGS if smoke else SYNTH_ARGS)
+    mesh = os.path.join(out, "mesh.ply")
+    if smoke:
+        meshes = {"full": "", "1k": decimated(tools, mesh, os.path.join(out, "mesh_1k.ply"), 1000)}
+    else:
+        meshes = {"full": "", "100k": decimated(tools, mesh, os.path.join(out, "mesh_100k.ply"), 100000),
+                  "10k": decimated(tools, mesh, os.path.join(out, "mesh_10k.ply"), 10000)}
+    return Project("synthetic", os.path.join(out, "project.mlp"), os.path.join(out, "heldout", "project.mlp"),
+                   gt=os.path.join(out, "ground_truth", "gt_vertex.ply"), meshes=meshes,
+                   photos=count_rasters(os.path.join(out, "project.mlp")))
+
+
+def shared_project(tools, work, name):
+    src = os.path.join(SHARED, "scenes", name)
+    if not os.path.isfile(os.path.join(src, "project.mlp")):
+        log(f"{name}: not found under {SHARED}/scenes, skipped")
+        return None
+    # The Lambertian-equivalent albedo of a coated material is albedo * diffuse_factor_normal.
+    with open(os.path.join(src, "gt_scene.json"), encoding="utf-8") as f:
+        factors = ",".join(str(m.get("diffuse_factor_normal", 1.0)) for m in json.load(f)["materials"])
+    mesh10k = decimated(tools, os.path.join(src, "mesh.ply"), os.path.join(work, "data", name, "mesh_10k.ply"), 10000)
+    return Project(name, os.path.join(src, "project.mlp"), os.path.join(src, "heldout", "project.mlp"),
+                   gt=os.path.join(src, "gt_vertex.ply"), photo_dir=os.path.join(src, "linear"),
+                   heldout_photo_dir=os.path.join(src, "heldout", "linear"), factors=factors,
+                   meshes={"full": "", "10k": mesh10k}, photos=count_rasters(os.path.join(src, "project.mlp")))
+
+
+def sample_project(name):
+    src = os.path.join(REPO, "sample_projects", name)
+    return Project(name, os.path.join(src, "project.mlp"), os.path.join(src, "heldout", "project.mlp"),
+                   gt=os.path.join(src, "ground_truth", "gt_vertex.ply"),
+                   photos=count_rasters(os.path.join(src, "project.mlp")))
+
+
+# ---------------------------------------------------------------------------------------------
+# Grid
+
+class Config:
+    def __init__(self, project, axis, mesh="full", backend="gpu", iterations=DEFAULT_CAP, photos=0, repeat=1):
+        self.project, self.axis, self.mesh, self.backend = project, axis, mesh, backend
+        self.iterations, self.photos, self.repeat = iterations, photos, repeat
+
+    def key(self):
+        return (self.project.name, self.mesh, self.backend, self.iterations, self.photos or self.project.photos)
+
+
+def reference_grid(p, ref_mesh, photo_counts, caps, meshes, repeat, reference_repeat):
+    g = []
+    for backend in ("gpu", "cpu"):
+        for cap in caps:
+            g.append(Config(p, "iterations", ref_mesh, backend, cap, 0,
+                            reference_repeat if cap == DEFAULT_CAP else repeat))
+        for n in photo_counts:
+            g.append(Config(p, "photos", ref_mesh, backend, DEFAULT_CAP, n, repeat))
+        for m in meshes:
+            g.append(Config(p, "mesh", m, backend, DEFAULT_CAP, 0, repeat))
+    return g
+
+
+def scene_grid(p, photo_counts, caps):
+    g = [Config(p, "photos", "full", "cpu", DEFAULT_CAP, n) for n in photo_counts if n < p.photos]
+    g += [Config(p, "iterations", "full", "cpu", c, 0) for c in caps]
+    g.append(Config(p, "backend", "full", "gpu", DEFAULT_CAP, 0))
+    if "10k" in p.meshes:
+        g.append(Config(p, "mesh", "10k", "cpu", DEFAULT_CAP, 0))
+    return g
+
+
+def build_grid(tools, work, smoke):
+    synth = synthetic_project(tools, work, smoke)
+    if smoke:
+        return reference_grid(synth, "full", [3], [1, DEFAULT_CAP], ["1k"], 1, 1)
+    grid = reference_grid(synth, "100k", [4, 8, 16], CAPS, ["10k", "full"], 2, 3)
+    grid.append(Config(synth, "backend", "100k", "cpu-all", DEFAULT_CAP, 0))
+    for name in SHARED_SCENES:
+        p = shared_project(tools, work, name)
+        if p:
+            grid += scene_grid(p, [4, 8, 16], [1, 5, DEFAULT_CAP, 50, 400])
+    for name in SAMPLE_PROJECTS:
+        grid += scene_grid(sample_project(name), [4, 8], [1, DEFAULT_CAP, 400])
+    return grid
+
+
+def run_config(tools, work, c):
+    p = c.project
+    cmd = [tools.bench, "fit", "--project", p.mlp, "--heldout", p.heldout, "--backend", c.backend,
+           "--iterations", str(c.iterations), "--photos", str(c.photos),
+           "--work", os.path.join(work, "runs", p.name), "--name", p.name]
+    for flag, value in (("--mesh", p.meshes[c.mesh]), ("--photo-dir", p.photo_dir), ("--gt", p.gt),
+                        ("--heldout-photo-dir", p.heldout_photo_dir), ("--albedo-factors", p.factors)):
+        if value:
+            cmd += [flag, value]
+    results = []
+    for _ in range(c.repeat):
+        out = run(cmd)
+        line = next(l for l in out.splitlines() if l.startswith("RESULT "))
+        results.append(json.loads(line[len("RESULT "):]))
+    # Repeated configurations keep the fastest run: other jobs on the shared machine only ever add
+    # time (the errors are the same in every run; the spread is kept as t_total_max).
+    results.sort(key=lambda r: r["t_total"])
+    row = dict(results[0])
+    row.update(scene=p.name, axis=c.axis, mesh=c.mesh, repeats=c.repeat, t_total_max=results[-1]["t_total"])
+    return row
+
+
+# ---------------------------------------------------------------------------------------------
+# Analysis
+
+def pareto(rows, x="t_total", y="relit_mean"):
+    """Marks rows not dominated in (time, error): no other row is at least as fast and as good."""
+    ordered = sorted(rows, key=lambda r: (r[x], r[y]))
+    best = math.inf
+    for r in ordered:
+        r["pareto"] = 1 if r[y] < best else 0
+        best = min(best, r[y])
+
+
+def short(r):
+    return f"{r['backend']} it{r['iterations']} p{r['photos']} {r['mesh']}"
+
+
+def write_csv(rows, path):
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        w = csv.DictWriter(f, fieldnames=CSV_COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{r[k]:.6g}" if isinstance(r.get(k), float) else r.get(k, "")) for k in CSV_COLUMNS})
+
+
+def plot(tools, rows, path, title, series, group, labels):
+    points = path + ".points.csv"
+    with open(points, "w", encoding="utf-8") as f:
+        f.write("series,x,y,front,label,group\n")
+        for r in rows:
+            label = short(r) if labels and r["pareto"] else ""
+            f.write(f"{series(r)},{r['t_total']},{r['relit_mean']},{r['pareto']},{label},{group(r)}\n")
+    run([tools.bench, "plot", "--points", points, "--out", path, "--title", title,
+         "--x-label", "total wall time (s, log scale)", "--y-label", "held-out relit CIEDE2000, mean"])
+    os.remove(points)
+
+
+def loglog_slope(pairs):
+    """Least-squares exponent b of t = a n^b."""
+    pts = [(math.log(n), math.log(t)) for n, t in pairs if n > 0 and t > 0]
+    if len(pts) < 2:
+        return float("nan")
+    mx = statistics.mean(p[0] for p in pts)
+    my = statistics.mean(p[1] for p in pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx if sxx > 0 else float("nan")
+
+
+def knee(rows, tolerance=0.02):
+    """Smallest cap whose relit mean CIEDE2000 is within `tolerance` (relative) of the best cap's:
+    beyond it more iterations buy less than 2 % of error."""
+    rows = sorted(rows, key=lambda r: r["iterations"])
+    if not rows:
+        return None
+    target = min(r["relit_mean"] for r in rows) * (1 + tolerance)
+    return next(r for r in rows if r["relit_mean"] <= target)
+
+
+STAGES = ["t_init", "t_prepare", "t_visibility", "t_gather", "t_fit", "t_output", "t_total"]
+
+
+def table(rows, columns, headers):
+    out = ["| " + " | ".join(headers) + " |", "|" + "|".join("---:" for _ in headers) + "|"]
+    for r in rows:
+        cells = []
+        for c in columns:
+            v = r.get(c, "")
+            cells.append(f"{v:.3g}" if isinstance(v, float) else str(v))
+        out.append("| " + " | ".join(cells) + " |")
+    return "\n".join(out)
+
+
+def summary(rows, smoke):
+    ref_mesh = "full" if smoke else "100k"
+    synth = [r for r in rows if r["scene"] == "synthetic"]
+    lines = ["# Benchmark summary (generated by run_benchmark.py)", ""]
+    ref = [r for r in synth if r["mesh"] == ref_mesh and r["photos"] == max(x["photos"] for x in synth)]
+    for backend in ("gpu", "cpu"):
+        sweep = sorted((r for r in ref if r["backend"] == backend and r["axis"] == "iterations"),
+                       key=lambda r: r["iterations"])
+        if not sweep:
+            continue
+        lines += [f"## Synthetic, {ref_mesh} vertices x {sweep[0]['photos']} photos, {backend}: iteration cap", "",
+                  table(sweep, ["iterations"] + STAGES + ["relit_mean", "relit_p95", "relit_psnr", "rho_de_mean",
+                                                          "ks_rel_median", "alpha_rel_median", "pareto"],
+                        ["cap", "init", "prepare", "visibility", "gather", "fit", "output", "total s",
+                         "relit dE mean", "relit dE p95", "PSNR dB", "rho dE", "k_s rel", "alpha rel", "front"]), ""]
+        k = knee(sweep)
+        if k:
+            best = min(sweep, key=lambda r: r["relit_mean"])
+            lines.append(f"knee ({backend}): cap {k['iterations']} (relit mean {k['relit_mean']:.3f}; best: cap "
+                         f"{best['iterations']}, {best['relit_mean']:.3f}; fit stage {k['t_fit']:.2f} s, "
+                         f"total {k['t_total']:.2f} s)")
+            lines.append("")
+    for axis, key, label in (("photos", "photos", "photos"), ("mesh", "vertices", "vertices")):
+        part = sorted((r for r in synth if r["axis"] in (axis, "iterations") and r["iterations"] == DEFAULT_CAP
+                       and (axis == "mesh" or r["mesh"] == ref_mesh)
+                       and (axis == "photos" or r["photos"] == max(x["photos"] for x in synth))),
+                      key=lambda r: (r["backend"], r[key]))
+        seen, uniq = set(), []
+        for r in part:
+            if (r["backend"], r[key]) not in seen:
+                seen.add((r["backend"], r[key]))
+                uniq.append(r)
+        if not uniq:
+            continue
+        lines += [f"## Synthetic: scaling with {label} (cap {DEFAULT_CAP})", "",
+                  table(uniq, ["backend", "vertices", "photos"] + STAGES + ["relit_mean", "relit_p95", "rho_de_mean"],
+                        ["back end", "vertices", "photos", "init", "prepare", "visibility", "gather", "fit",
+                         "output", "total s", "relit dE mean", "relit dE p95", "rho dE"]), ""]
+        for backend in ("gpu", "cpu"):
+            pairs = [(r[key], r["t_total"]) for r in uniq if r["backend"] == backend]
+            fit_pairs = [(r[key], r["t_fit"]) for r in uniq if r["backend"] == backend]
+            if len(pairs) >= 2:
+                lines.append(f"- {backend}: total time ~ {label}^{loglog_slope(pairs):.2f}, "
+                             f"fit stage ~ {label}^{loglog_slope(fit_pairs):.2f}")
+        lines.append("")
+    others = [r for r in rows if r["scene"] != "synthetic"]
+    if others:
+        lines += ["## Shared scenes and sample projects", "",
+                  table(sorted(others, key=lambda r: (r["scene"], r["axis"], r["backend"], r["photos"], r["iterations"])),
+                        ["scene", "axis", "mesh", "vertices", "photos", "backend", "iterations", "t_total", "t_fit",
+                         "relit_mean", "relit_p95", "relit_psnr", "rho_de_mean", "coverage", "pareto"],
+                        ["scene", "axis", "mesh", "vertices", "photos", "back end", "cap", "total s", "fit s",
+                         "relit dE mean", "relit dE p95", "PSNR dB", "rho dE", "coverage", "front"]), ""]
+    rest = [r for r in synth if r["axis"] == "backend"]
+    if rest:
+        lines += ["## Synthetic: CPU visibility (ray cast) + CPU fit", "",
+                  table(rest, ["backend", "vertices", "photos"] + STAGES + ["relit_mean"],
+                        ["back end", "vertices", "photos", "init", "prepare", "visibility", "gather", "fit", "output",
+                         "total s", "relit dE mean"]), ""]
+    return "\n".join(lines) + "\n"
+
+
+def check_rows(rows):
+    """Smoke checks: every configuration produced finite times and errors."""
+    failures = []
+    for r in rows:
+        for k in ("t_total", "t_fit", "relit_mean", "relit_p95", "rho_de_mean"):
+            v = r.get(k)
+            if not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                failures.append(f"{short(r)}: {k} = {v}")
+        if r.get("relit_pixels", 0) <= 0:
+            failures.append(f"{short(r)}: no held-out pixel compared")
+    return failures
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bench", required=True, help="vbrdf_bench executable")
+    ap.add_argument("--synth", required=True, help="synthesize_scene executable")
+    ap.add_argument("--work", required=True, help="scratch folder (generated data is reused)")
+    ap.add_argument("--out", required=True, help="folder for results.csv, plots, summary.md")
+    ap.add_argument("--smoke", action="store_true", help="tiny grid for ctest")
+    ap.add_argument("--only", default="", help="run only configurations of scenes containing this text")
+    a = ap.parse_args(argv)
+    os.makedirs(a.out, exist_ok=True)
+    start = time.time()
+    grid = build_grid(a, a.work, a.smoke)
+    grid = [c for c in grid if a.only in c.project.name]
+    seen, unique = set(), []
+    for c in grid:  # the reference configuration appears on several axes
+        if c.key() not in seen:
+            seen.add(c.key())
+            unique.append(c)
+    log(f"{len(unique)} configurations (data ready after {time.time() - start:.0f} s)")
+    rows = []
+    for i, c in enumerate(unique):
+        row = run_config(a, a.work, c)
+        rows.append(row)
+        log(f"[{i + 1}/{len(unique)}] {c.project.name:26s} {short(row):28s} total {row['t_total']:7.2f} s "
+            f"(fit {row['t_fit']:.2f}) relit dE {row['relit_mean']:.3f} / p95 {row['relit_p95']:.2f}")
+    for scene in {r["scene"] for r in rows}:
+        pareto([r for r in rows if r["scene"] == scene])
+    write_csv(rows, os.path.join(a.out, "results.csv"))
+    synth = [r for r in rows if r["scene"] == "synthetic"]
+    if synth:
+        plot(a, synth, os.path.join(a.out, "time_vs_error.png"),
+             "Synthetic scene (1024x768, 8 held-out lights): time vs relit error",
+             lambda r: f"{r['backend']} {r['axis']}", lambda r: "all", labels=True)
+    others = [r for r in rows if r["scene"] != "synthetic"]
+    if others:
+        plot(a, others, os.path.join(a.out, "time_vs_error_scenes.png"),
+             "Shared scenes and sample projects: time vs held-out relit error (front per scene)",
+             lambda r: r["scene"], lambda r: r["scene"], labels=False)
+    with open(os.path.join(a.out, "summary.md"), "w", encoding="utf-8") as f:
+        f.write(summary(rows, a.smoke))
+    log(f"wrote {a.out}/results.csv, summary.md and plots; {len(rows)} configurations in {time.time() - start:.0f} s")
+    failures = check_rows(rows)
+    for msg in failures:
+        log("FAIL: " + msg)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

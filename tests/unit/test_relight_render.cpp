@@ -1,0 +1,297 @@
+// Image-space relighting (relight_render.h): renders against analytic answers (per-pixel Phong,
+// cast shadows, unfitted vertices), the photo comparison, the written images and table, and the
+// novel-view camera. GL through OSMesa; skipped when no context can be created.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "color_difference.h"
+#include "errors.h"
+#include "file_util.h"
+#include "osmesa_context.h"
+#include "relight_render.h"
+#include "test_paths.h"
+#include "test_scenes.h"
+
+namespace vbrdf {
+namespace {
+
+constexpr int kW = 160, kH = 120;
+
+std::unique_ptr<test::OsMesaContext> context_or_skip(std::string &why) {
+  return test::OsMesaContext::try_create(&why);
+}
+#define REQUIRE_GL(ctx)                                   \
+  std::string why_;                                       \
+  auto ctx = context_or_skip(why_);                       \
+  if (!ctx) GTEST_SKIP() << "no OSMesa context: " << why_
+
+VertexFit phong_fit(const float rho[3], float ks, float shininess) {
+  VertexFit f{};
+  f.kd = std::max(rho[0], std::max(rho[1], rho[2]));
+  for (int c = 0; c < 3; ++c) f.color[c] = f.kd > 0 ? rho[c] / f.kd : 0;
+  f.ks = ks;
+  f.shininess = shininess;
+  f.status = ks > 0 ? kFitFull : kFitDiffuseOnly;
+  return f;
+}
+
+// A camera above the plane y = 0 looking down (slightly tilted so that the view is generic).
+Shot top_camera() {
+  const float eye[3] = {0.2f, 3.0f, 0.6f}, target[3] = {0, 0, 0}, up[3] = {0, 0, -1};
+  return test::make_look_at_shot(eye, target, up, 150, kW, kH);
+}
+
+// Ray through the centre of image pixel (x, y) intersected with the plane y = 0.
+vcg::Point3f plane_point(const Shot &shot, int x, int y) {
+  const vcg::Point2f vcg_px(x + 0.5f, float(shot.Intrinsics.ViewportPx[1]) - (y + 0.5f));
+  const vcg::Point3f far_point = shot.UnProject(vcg_px, 1.0f), c = shot.GetViewPoint();
+  const vcg::Point3f dir = far_point - c;
+  return c + dir * (-c[1] / dir[1]);
+}
+
+size_t count_class(const RelitImage &r, uint8_t cls) {
+  size_t n = 0;
+  for (uint8_t c : r.pixel_class) n += c == cls;
+  return n;
+}
+
+const float *pixel(const RelitImage &r, int x, int y) { return &r.rgb[3 * (size_t(y) * size_t(r.width) + size_t(x))]; }
+uint8_t pixel_class(const RelitImage &r, int x, int y) { return r.pixel_class[size_t(y) * size_t(r.width) + size_t(x)]; }
+
+TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
+  REQUIRE_GL(ctx);
+  const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
+  const float rho[3] = {0.5f, 0.3f, 0.1f};
+  const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
+  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
+  const Shot shot = top_camera();
+  float light[3] = {0.3f, 1.0f, 0.4f};
+  const float len = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+  for (float &c : light) c /= len;
+  const RelitImage r = renderer.render(shot, light);
+  ASSERT_EQ(r.width, kW);
+  ASSERT_EQ(r.height, kH);
+  EXPECT_EQ(count_class(r, kRelitShadowed), 0u);
+  EXPECT_EQ(count_class(r, kRelitNoFit), 0u);
+  size_t checked = 0;
+  double worst = 0;
+  for (int y = 2; y < kH - 2; y += 3)
+    for (int x = 2; x < kW - 2; x += 3) {
+      if (pixel_class(r, x, y) != kRelitLit) continue;
+      const vcg::Point3f p = plane_point(shot, x, y), e = (shot.GetViewPoint() - p).Normalize();
+      const vcg::Point3f n(0, 1, 0), l(light[0], light[1], light[2]);
+      const float d = n * l;
+      const vcg::Point3f refl = n * (2 * d) - l;
+      float expected[3];
+      evaluate_phong(fits[0], d, refl * e, expected);
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::fabs(pixel(r, x, y)[c] - expected[c])));
+      ++checked;
+    }
+  EXPECT_GT(checked, 500u);  // the plane fills the view
+  EXPECT_LT(worst, 2e-3);
+}
+
+TEST(RelightRender, CastShadowsAndUnfittedVertices) {
+  REQUIRE_GL(ctx);
+  // Ground plane plus a small plate at height 1 over the origin; light from +x, 45 degrees up:
+  // the plate's shadow falls around x = -1 on the ground.
+  MeshData mesh = test::make_grid(40, 2.0f, 0.0f);
+  test::append_mesh(mesh, test::make_grid(4, 0.3f, 1.0f));
+  const size_t n = mesh.positions.size() / 3;
+  const float grey[3] = {0.5f, 0.5f, 0.5f};
+  std::vector<VertexFit> fits(n, phong_fit(grey, 0, 0));
+  // The ground's far corner (x, z > 1.5) has no fit.
+  for (size_t v = 0; v < 41 * 41; ++v)
+    if (mesh.positions[3 * v] > 1.5f && mesh.positions[3 * v + 2] > 1.5f) fits[v] = VertexFit{};
+  const float eye[3] = {0.0f, 6.0f, 0.01f}, target[3] = {0, 0, 0}, up[3] = {0, 0, -1};
+  const Shot shot = test::make_look_at_shot(eye, target, up, 200, 320, 240);
+  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
+  const float s = std::sqrt(0.5f), light[3] = {s, s, 0};
+  const RelitImage r = renderer.render(shot, light);
+  auto class_at = [&](float x, float z) {
+    const float w[3] = {x, 0.0f, z};
+    const ImagePoint p = project_to_image(shot, w);
+    return pixel_class(r, int(p.x), int(p.y));
+  };
+  EXPECT_EQ(class_at(-1.0f, 0.0f), kRelitShadowed);  // under the plate's shadow
+  EXPECT_EQ(class_at(1.0f, 0.0f), kRelitLit);        // the mirror position is lit
+  EXPECT_EQ(class_at(-1.0f, 1.0f), kRelitLit);       // beside the shadow
+  EXPECT_EQ(class_at(1.8f, 1.8f), kRelitNoFit);
+  const ImagePoint q = project_to_image(shot, std::array<float, 3>{{1.0f, 0.0f, 0.0f}}.data());
+  EXPECT_NEAR(pixel(r, int(q.x), int(q.y))[0], 0.5f * s, 1e-3f);  // rho N.L
+  // Light from below: everything faces away.
+  const float below[3] = {0, -1, 0};
+  const RelitImage dark = renderer.render(shot, below);
+  EXPECT_EQ(count_class(dark, kRelitLit), 0u);
+  EXPECT_EQ(count_class(dark, kRelitShadowed) + count_class(dark, kRelitNoFit),
+            size_t(320 * 240) - count_class(dark, kRelitBackground));
+  EXPECT_GT(count_class(dark, kRelitShadowed), size_t(320 * 240 / 10));
+}
+
+TEST(RelightRender, RejectsMismatchedFitsAndBadLights) {
+  REQUIRE_GL(ctx);
+  const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
+  EXPECT_THROW(RelightRenderer(mesh.view(), std::vector<VertexFit>(3), ctx->get_proc_address()), InputError);
+  RelightRenderer renderer(mesh.view(), std::vector<VertexFit>(9), ctx->get_proc_address());
+  const float zero[3] = {0, 0, 0};
+  EXPECT_THROW(renderer.render(top_camera(), zero), InputError);
+  EXPECT_THROW(renderer.render(Shot(), std::array<float, 3>{{0, 1, 0}}.data()), InputError);
+}
+
+// A flat plane lit head on: its photo is rho everywhere on the plane (16-bit linear PNG).
+struct FlatScene {
+  MeshData mesh = test::make_grid(10, 1.0f, 0.0f);
+  Raster raster;
+  std::array<float, 3> light{{0, 1, 0}};
+  std::string dir = test::scratch_dir("relight_render");
+  FlatScene(const float photo_rho[3], const float model_rho[3], std::vector<VertexFit> &fits) {
+    const float eye[3] = {0, 4, 0.01f}, target[3] = {0, 0, 0}, up[3] = {0, 0, -1};
+    raster.shot = test::make_look_at_shot(eye, target, up, 120, kW, kH);
+    raster.label = "held out, 1";
+    raster.image_path = dir + "/held_out.png";
+    cv::Mat img(kH, kW, CV_16UC3, cv::Scalar(0, 0, 0));
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const vcg::Point3f p = plane_point(raster.shot, x, y);
+        if (std::fabs(p[0]) < 0.98f && std::fabs(p[2]) < 0.98f)
+          img.at<cv::Vec3w>(y, x) = cv::Vec3w(uint16_t(photo_rho[2] * 65535), uint16_t(photo_rho[1] * 65535),
+                                               uint16_t(photo_rho[0] * 65535));
+      }
+    cv::imwrite(raster.image_path, img);
+    fits.assign(mesh.positions.size() / 3, phong_fit(model_rho, 0, 0));
+  }
+};
+
+TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
+  REQUIRE_GL(ctx);
+  const float rho[3] = {0.6f, 0.4f, 0.2f}, wrong[3] = {0.3f, 0.4f, 0.2f};
+  std::vector<VertexFit> fits;
+  FlatScene scene(rho, rho, fits);
+  RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address());
+  const RelightReport good = relight_rasters(renderer, {scene.raster}, {scene.light}, RelightOutputOptions());
+  ASSERT_EQ(good.rows.size(), 1u);
+  const PixelComparison &c = good.rows[0].comparison;
+  EXPECT_GT(c.pixels, 2000u);
+  EXPECT_LT(c.mean_de2000, 0.05);
+  EXPECT_LT(c.p95_de2000, 0.1);
+  EXPECT_GT(c.psnr_db, 60.0);
+  EXPECT_TRUE(good.files.empty());  // no folder: nothing written
+  ASSERT_FALSE(good.color_log.empty());  // no chart in this photo: compared as decoded, and said so
+  EXPECT_NE(good.color_log.back().find("no usable chart"), std::string::npos) << good.color_log.back();
+  RelightOutputOptions required;
+  required.color_correction = RelightColorCorrection::Required;
+  EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {scene.light}, required), InputError);
+  RelightOutputOptions corners;
+  corners.chart_corners = {1, 2, 3};
+  EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {scene.light}, corners), InputError);
+  RelightOutputOptions off;
+  off.color_correction = RelightColorCorrection::Off;
+  EXPECT_TRUE(relight_rasters(renderer, {scene.raster}, {scene.light}, off).color_log.empty());
+  // Silhouette pixels are never compared: fewer pixels than the plane covers.
+  const RelitImage r = renderer.render(scene.raster.shot, scene.light.data());
+  EXPECT_LT(c.pixels, count_class(r, kRelitLit));
+
+  std::vector<VertexFit> wrong_fits;
+  FlatScene other(rho, wrong, wrong_fits);
+  RelightRenderer wrong_renderer(other.mesh.view(), wrong_fits, ctx->get_proc_address());
+  const RelightReport bad = relight_rasters(wrong_renderer, {other.raster}, {other.light}, RelightOutputOptions());
+  const double expected = delta_e2000_linear_srgb(wrong, rho);
+  EXPECT_NEAR(bad.rows[0].comparison.mean_de2000, expected, 0.05);
+  EXPECT_NEAR(bad.rows[0].comparison.p95_de2000, expected, 0.05);
+  EXPECT_NEAR(bad.overall.comparison.mean_de2000, expected, 0.05);
+  EXPECT_LT(bad.rows[0].comparison.psnr_db, 25.0);
+}
+
+TEST(RelightRender, WritesImagesContactSheetAndTable) {
+  REQUIRE_GL(ctx);
+  const float rho[3] = {0.6f, 0.4f, 0.2f}, model[3] = {0.5f, 0.4f, 0.25f};
+  std::vector<VertexFit> fits;
+  FlatScene scene(rho, model, fits);
+  RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address());
+  RelightOutputOptions options;
+  options.folder = scene.dir + "/out/nested";
+  Raster second = scene.raster;
+  second.label = "second";
+  const RelightReport report = relight_rasters(renderer, {scene.raster, second}, {scene.light, scene.light}, options);
+  ASSERT_EQ(report.files.size(), 4u);
+  for (const std::string &f : report.files) EXPECT_TRUE(file_exists(f)) << f;
+  EXPECT_EQ(file_name_of(report.files[0]), "relight_000_held_out__1.png");
+  const cv::Mat panel = cv::imread(report.files[0]);
+  EXPECT_EQ(panel.cols, 3 * kW);
+  EXPECT_GT(panel.rows, kH);
+  EXPECT_FALSE(cv::imread(options.folder + "/contact_sheet.png").empty());
+  std::ifstream csv(options.folder + "/relight_table.csv");
+  std::string header, row1, row2, all;
+  std::getline(csv, header);
+  std::getline(csv, row1);
+  std::getline(csv, row2);
+  std::getline(csv, all);
+  EXPECT_EQ(header, "raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db");
+  EXPECT_EQ(row1.rfind("\"held out, 1\",", 0), 0u) << row1;  // labels with commas are quoted
+  EXPECT_EQ(all.rfind("all,,", 0), 0u) << all;
+  EXPECT_NEAR(report.overall.comparison.mean_de2000, report.rows[0].comparison.mean_de2000, 1e-9);
+  EXPECT_EQ(report.overall.comparison.pixels, 2 * report.rows[0].comparison.pixels);
+
+  // Never over a photo; a missing photo is named with its raster.
+  RelightOutputOptions over = options;
+  over.folder = scene.dir;
+  Raster clash = scene.raster;
+  clash.image_path = scene.dir + "/contact_sheet.png";
+  EXPECT_THROW(relight_rasters(renderer, {clash}, {scene.light}, over), InputError);
+  Raster missing = scene.raster;
+  missing.image_path = scene.dir + "/nope.png";
+  try {
+    relight_rasters(renderer, {missing}, {scene.light}, RelightOutputOptions());
+    FAIL();
+  } catch (const InputError &e) {
+    EXPECT_NE(std::string(e.what()).find("held out, 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RelightRender, OrbitShotKeepsThePivotInViewAndMovesTheCamera) {
+  const float eye[3] = {0, 1, 5}, target[3] = {0, 1, 0}, up[3] = {0, 1, 0};
+  const Shot base = test::make_look_at_shot(eye, target, up, 500, 640, 480);
+  const Shot same = orbit_shot(base, target, 0, 0, 1);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(same.GetViewPoint()[k], base.GetViewPoint()[k], 1e-5);
+  const Shot right = orbit_shot(base, target, 90, 0, 2);
+  EXPECT_NEAR(right.GetViewPoint()[0], 10.0, 1e-4);  // moved to the camera's right (+x), twice as far
+  EXPECT_NEAR(right.GetViewPoint()[1], 1.0, 1e-4);
+  EXPECT_NEAR(right.GetViewPoint()[2], 0.0, 1e-4);
+  const Shot above = orbit_shot(base, target, 0, 30, 1);
+  EXPECT_GT(above.GetViewPoint()[1], 1.0f + 2.4f);
+  for (const Shot *s : {&right, &above}) {
+    const ImagePoint p = project_to_image(*s, target);
+    EXPECT_NEAR(p.x, 320.0, 1e-2);
+    EXPECT_NEAR(p.y, 240.0, 1e-2);
+    EXPECT_TRUE(shot_is_valid(*s));
+  }
+  EXPECT_THROW(orbit_shot(base, target, 0, 0, 0), InputError);
+}
+
+TEST(RelightRender, PoolsComparisonsAndMakesSafeNames) {
+  PixelComparison a, b;
+  a.pixels = 3, a.mean_de2000 = 1, a.squared_error = 0.03;
+  b.pixels = 1, b.mean_de2000 = 5, b.squared_error = 0.01;
+  a.histogram.assign(kDeHistogramBins, 0);
+  b.histogram.assign(kDeHistogramBins, 0);
+  a.histogram[100] = 3;
+  b.histogram[500] = 1;
+  const PixelComparison p = pool_comparisons({&a, &b});
+  EXPECT_EQ(p.pixels, 4u);
+  EXPECT_DOUBLE_EQ(p.mean_de2000, 2.0);
+  EXPECT_NEAR(p.median_de2000, 1.005, 1e-9);
+  EXPECT_NEAR(p.p95_de2000, 5.005, 1e-9);
+  EXPECT_NEAR(p.psnr_db, 10 * std::log10(1.0 / (0.04 / 12)), 1e-9);
+  EXPECT_EQ(file_safe_label("a b/c.png"), "a_b_c.png");
+  EXPECT_EQ(file_safe_label(""), "raster");
+}
+
+} // namespace
+} // namespace vbrdf
