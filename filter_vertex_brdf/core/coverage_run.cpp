@@ -505,18 +505,16 @@ LightSuggestion suggest_light_with_tolerance(const MeshView &mesh, const Shot &v
 }
 
 namespace {
-// The vertices that need samples (visible, weight > 0) with, in CSR form, the taken lights that
-// were predicted to give them one: each such light failed them (they still need samples).
+// The vertices that need samples (visible, weight > 0) with, as a bitmask over the taken lights,
+// those that were predicted to give them one: each such light failed them (they still need it).
 struct NeedingSet {
   std::vector<uint32_t> vertex;
-  std::vector<float> n, e, w;           // 3 floats per vertex for n and e
-  std::vector<uint32_t> offset, failed; // failed[offset[i] .. offset[i+1]): indices into the taken lights
+  std::vector<float> n, e, w;     // unit normal and eye direction (3 floats each), weight
+  size_t words = 0;               // 64-bit words per vertex in `failed`
+  std::vector<uint64_t> failed;   // vertex-major: failed[i * words + t / 64] bit t % 64
+  std::vector<uint8_t> any_failed;
   size_t size() const { return vertex.size(); }
 };
-
-bool covers_kind(CoverageKind kind, const float *n, const float *e, const float *l, const LightSuggestionSettings &s) {
-  return covers_unit(kind, n, e, l, s);
-}
 
 NeedingSet needing_set(const MeshView &mesh, const Shot &viewpoint, const uint8_t *visible, const float *needs,
                        CoverageKind kind, const LightSuggestionSettings &s,
@@ -525,47 +523,75 @@ NeedingSet needing_set(const MeshView &mesh, const Shot &viewpoint, const uint8_
   for (size_t v = 0; v < mesh.vertex_count; ++v)
     if (needs[v] > 0 && visible[v]) out.vertex.push_back(uint32_t(v));
   const size_t m = out.size();
-  out.n.resize(3 * m), out.e.resize(3 * m), out.w.resize(m), out.offset.assign(m + 1, 0);
+  out.words = (taken.size() + 63) / 64;
+  out.n.resize(3 * m), out.e.resize(3 * m), out.w.resize(m), out.any_failed.assign(m, 0);
+  out.failed.assign(m * out.words, 0);
   float centre[3];
   camera_centre(viewpoint, centre);
-  std::vector<uint32_t> count(m, 0);
 #pragma omp parallel for schedule(static)
   for (long long ii = 0; ii < (long long)m; ++ii) {
     const size_t i = size_t(ii), v = out.vertex[i];
-    unit_normal(mesh.normals + 3 * v, &out.n[3 * i]);
-    eye_direction(centre, mesh.positions + 3 * v, &out.e[3 * i]);
+    float *n = &out.n[3 * i], *e = &out.e[3 * i];
+    unit_normal(mesh.normals + 3 * v, n);
+    eye_direction(centre, mesh.positions + 3 * v, e);
     out.w[i] = needs[v];
-    for (const auto &l : taken) count[i] += covers_kind(kind, &out.n[3 * i], &out.e[3 * i], l.data(), s);
-  }
-  for (size_t i = 0; i < m; ++i) out.offset[i + 1] = out.offset[i] + count[i];
-  out.failed.resize(out.offset[m]);
-#pragma omp parallel for schedule(static)
-  for (long long ii = 0; ii < (long long)m; ++ii) {
-    const size_t i = size_t(ii);
-    uint32_t k = out.offset[i];
     for (size_t t = 0; t < taken.size(); ++t)
-      if (count[i] && covers_kind(kind, &out.n[3 * i], &out.e[3 * i], taken[t].data(), s)) out.failed[k++] = uint32_t(t);
+      if (covers_unit(kind, n, e, taken[t].data(), s)) {
+        out.failed[i * out.words + t / 64] |= uint64_t(1) << (t % 64);
+        out.any_failed[i] = 1;
+      }
   }
   return out;
 }
 
-// Whether light `l` is expected to give needing vertex i a sample: predicted, and no light that
-// failed it lies within the cone.
-bool counts_for(const NeedingSet &x, size_t i, const float *l, CoverageKind kind, const LightSuggestionSettings &s,
-                const std::vector<std::array<float, 3>> &taken, float cone_cos) {
-  if (!covers_kind(kind, &x.n[3 * i], &x.e[3 * i], l, s)) return false;
-  for (uint32_t k = x.offset[i]; k < x.offset[i + 1]; ++k)
-    if (dot3(taken[x.failed[k]].data(), l) >= cone_cos) return false;
+// Bitmask of the taken lights within the cone around `l`.
+std::vector<uint64_t> near_mask(const float *l, const std::vector<std::array<float, 3>> &taken, float cone_cos,
+                                size_t words) {
+  std::vector<uint64_t> mask(words, 0);
+  for (size_t t = 0; t < taken.size(); ++t)
+    if (dot3(taken[t].data(), l) >= cone_cos) mask[t / 64] |= uint64_t(1) << (t % 64);
+  return mask;
+}
+
+// Whether light `l` (with its near_mask) is expected to give needing vertex i a sample: predicted,
+// and no light that failed it lies within the cone.
+bool counts_for(const NeedingSet &x, size_t i, const float *l, const std::vector<uint64_t> &near, CoverageKind kind,
+                const LightSuggestionSettings &s) {
+  if (!covers_unit(kind, &x.n[3 * i], &x.e[3 * i], l, s)) return false;
+  if (!x.any_failed[i]) return true;
+  for (size_t w = 0; w < x.words; ++w)
+    if (x.failed[i * x.words + w] & near[w]) return false;
   return true;
+}
+
+// Leaves out, before the first search, the failed vertices whose own best light (the normal for
+// diffuse, the mirror direction for specular) lies near a light that failed them: their ideal
+// light (Algorithms 1 and 3) would point there again.
+void drop_failed_ideals(const NeedingSet &x, CoverageKind kind, const std::vector<std::array<float, 3>> &taken,
+                        float cone_cos, std::vector<float> &work) {
+#pragma omp parallel for schedule(static)
+  for (long long ii = 0; ii < (long long)x.size(); ++ii) {
+    const size_t i = size_t(ii);
+    if (!x.any_failed[i]) continue;
+    const float *n = &x.n[3 * i], *e = &x.e[3 * i];
+    const float ne = dot3(n, e);
+    const float mirror[3] = {2 * ne * n[0] - e[0], 2 * ne * n[1] - e[1], 2 * ne * n[2] - e[2]};
+    const float *ideal = kind == CoverageKind::Diffuse ? n : mirror;
+    for (size_t t = 0; t < taken.size(); ++t)
+      if (((x.failed[i * x.words + t / 64] >> (t % 64)) & 1u) && dot3(taken[t].data(), ideal) >= cone_cos) {
+        work[x.vertex[i]] = 0;
+        break;
+      }
+  }
 }
 
 // Best direction of a uniform set over the placeable hemisphere, scored with counts_for (the ideal
 // lights of the vertices left all failed before: look elsewhere). Invalid when nothing counts.
-LightSuggestion explore_directions(const NeedingSet &x, const std::vector<float> &work, const Shot &viewpoint,
-                                   CoverageKind kind, const LightSuggestionSettings &s,
-                                   const std::vector<std::array<float, 3>> &taken, float cone_cos) {
-  constexpr int kDirections = 800;
-  constexpr size_t kMaxScored = 20000;  // larger sets are subsampled for the score
+LightSuggestion explore_directions(const NeedingSet &x, const Shot &viewpoint, CoverageKind kind,
+                                   const LightSuggestionSettings &s, const std::vector<std::array<float, 3>> &taken,
+                                   float cone_cos) {
+  constexpr int kDirections = 600;
+  constexpr size_t kMaxScored = 8000;  // larger sets are subsampled for the score
   const size_t stride = std::max<size_t>(1, (x.size() + kMaxScored - 1) / kMaxScored);
   const float zmin = std::sin(s.min_elevation_deg * kPi / 180);
   std::vector<double> score(kDirections, 0);
@@ -577,10 +603,11 @@ LightSuggestion explore_directions(const NeedingSet &x, const std::vector<float>
     camera_to_world_direction(viewpoint, cams[size_t(d)].data(), dirs[size_t(d)].data());
   }
 #pragma omp parallel for schedule(dynamic, 8)
-  for (int d = 0; d < kDirections; ++d)
+  for (int d = 0; d < kDirections; ++d) {
+    const std::vector<uint64_t> near = near_mask(dirs[size_t(d)].data(), taken, cone_cos, x.words);
     for (size_t i = 0; i < x.size(); i += stride)
-      if (work[x.vertex[i]] > 0 && counts_for(x, i, dirs[size_t(d)].data(), kind, s, taken, cone_cos))
-        score[size_t(d)] += x.w[i];
+      if (counts_for(x, i, dirs[size_t(d)].data(), near, kind, s)) score[size_t(d)] += x.w[i];
+  }
   const size_t best = size_t(std::max_element(score.begin(), score.end()) - score.begin());
   LightSuggestion out;
   if (!(score[best] > 0)) return out;
@@ -589,9 +616,9 @@ LightSuggestion explore_directions(const NeedingSet &x, const std::vector<float>
   std::copy(cams[best].begin(), cams[best].end(), out.dir_cam);
   out.azimuth_deg = std::atan2(out.dir_cam[1], out.dir_cam[0]) * 180 / kPi;
   out.elevation_deg = std::asin(std::min(1.0f, out.dir_cam[2])) * 180 / kPi;
+  const std::vector<uint64_t> near = near_mask(out.dir_world, taken, cone_cos, x.words);
   for (size_t i = 0; i < x.size(); ++i)
-    if (work[x.vertex[i]] > 0 && counts_for(x, i, out.dir_world, kind, s, taken, cone_cos))
-      ++out.covered_vertices, out.covered_weight += x.w[i];
+    if (counts_for(x, i, out.dir_world, near, kind, s)) ++out.covered_vertices, out.covered_weight += x.w[i];
   return out;
 }
 } // namespace
@@ -602,23 +629,28 @@ LightSuggestion suggest_light_learning(const MeshView &mesh, const Shot &viewpoi
                                        float failure_cone_deg, size_t *robust_covered, bool *repeats_failed,
                                        bool brute_force) {
   if (repeats_failed) *repeats_failed = false;
-  const LightSuggestion plain =
-      suggest_light_with_tolerance(mesh, viewpoint, visible, needs, kind, s, tolerance_deg, robust_covered, brute_force);
+  const auto suggest = [&](const float *weights) {
+    return suggest_light_with_tolerance(mesh, viewpoint, visible, weights, kind, s, tolerance_deg, robust_covered,
+                                        brute_force);
+  };
+  const LightSuggestion plain = suggest(needs);
   if (taken_lights.empty() || failure_cone_deg <= 0 || plain.needing_vertices == 0) return plain;
   const float cone_cos = std::cos(failure_cone_deg * kPi / 180);
   const NeedingSet x = needing_set(mesh, viewpoint, visible, needs, kind, s, taken_lights);
-  if (x.failed.empty()) return plain;  // nothing failed so far: nothing to learn
+  if (std::find(x.any_failed.begin(), x.any_failed.end(), 1) == x.any_failed.end()) return plain;  // nothing to learn
   std::vector<float> work(needs, needs + mesh.vertex_count);
-  LightSuggestion sg = plain;
-  constexpr int kRounds = 5;
+  drop_failed_ideals(x, kind, taken_lights, cone_cos, work);
+  LightSuggestion sg = suggest(work.data());
+  constexpr int kRounds = 4;
   for (int round = 0; sg.valid; ++round) {
     // Vertices this light would not cover after all (a photo near it failed them).
+    const std::vector<uint64_t> near = near_mask(sg.dir_world, taken_lights, cone_cos, x.words);
     size_t removed = 0;
 #pragma omp parallel for reduction(+ : removed) schedule(static)
     for (long long ii = 0; ii < (long long)x.size(); ++ii) {
       const size_t i = size_t(ii), v = x.vertex[i];
-      if (work[v] > 0 && x.offset[i + 1] > x.offset[i] && covers_kind(kind, &x.n[3 * i], &x.e[3 * i], sg.dir_world, s) &&
-          !counts_for(x, i, sg.dir_world, kind, s, taken_lights, cone_cos))
+      if (work[v] > 0 && x.any_failed[i] && covers_unit(kind, &x.n[3 * i], &x.e[3 * i], sg.dir_world, s) &&
+          !counts_for(x, i, sg.dir_world, near, kind, s))
         work[v] = 0, ++removed;
     }
     // A few broken promises do not change the best light; many do: recompute without them.
@@ -627,11 +659,10 @@ LightSuggestion suggest_light_learning(const MeshView &mesh, const Shot &viewpoi
       sg = LightSuggestion();  // still mostly broken promises: look elsewhere
       break;
     }
-    sg = suggest_light_with_tolerance(mesh, viewpoint, visible, work.data(), kind, s, tolerance_deg, robust_covered, brute_force);
+    sg = suggest(work.data());
   }
   if (!sg.valid) {
-    std::vector<float> all(needs, needs + mesh.vertex_count);
-    sg = explore_directions(x, all, viewpoint, kind, s, taken_lights, cone_cos);
+    sg = explore_directions(x, viewpoint, kind, s, taken_lights, cone_cos);
     if (robust_covered) *robust_covered = 0;
     if (!sg.valid) {  // every light that could help failed before: the best of them again
       if (repeats_failed) *repeats_failed = plain.valid;

@@ -17,9 +17,9 @@
 
 #include "camera.h"
 #include "coverage.h"
+#include "light_file.h"
 #include "mesh_view.h"
 #include "pipeline.h"
-#include "light_file.h"
 #include "samples.h"
 #include "sphere_lights.h"
 #include "visibility.h"
@@ -99,11 +99,15 @@ LightSuggestion suggest_light_with_tolerance(const MeshView &mesh, const Shot &v
 // The next light, learning from the photos taken so far: a vertex that still needs samples
 // although a photo's light near the suggestion (within `failure_cone_deg`) was predicted to give
 // it one (a cast shadow or a clipped pixel prevented it; the prediction cannot know) does not
-// count for that suggestion, which is then recomputed without it (at most 4 rounds). Otherwise the
-// vertex's ideal light would bring the same failed light back again and again. When every light
-// predicted to help has failed, the plain suggestion is returned and *repeats_failed (optional)
-// is set. `taken_lights`: world directions of the photos of this viewpoint (and of suggestions
-// that were followed). Needs and tolerance as above.
+// count for that suggestion. Otherwise the vertex's ideal light (Algorithms 1/3) would bring the
+// same failed light back again and again. So: failed vertices whose own best direction (normal,
+// mirror direction) lies near a light that failed them are left out of the binned search; a
+// suggestion that still counts many failed vertices is recomputed without them (at most 4
+// rounds); if nothing is left, 600 directions over the placeable hemisphere are scored with the
+// failures taken into account. When every light predicted to help has failed, the plain
+// suggestion is returned and *repeats_failed (optional) is set. Without taken lights or failures
+// this is suggest_light_with_tolerance. `taken_lights`: world directions of the photos of this
+// viewpoint (and of suggestions that were followed). Needs and tolerance as above.
 LightSuggestion suggest_light_learning(const MeshView &mesh, const Shot &viewpoint, const uint8_t *visible,
                                        const float *needs, CoverageKind kind, const LightSuggestionSettings &s,
                                        float tolerance_deg, const std::vector<std::array<float, 3>> &taken_lights,
@@ -184,9 +188,13 @@ std::unique_ptr<VisibilityBackend> make_coverage_visibility(const MeshView &mesh
 
 // Runs everything and, when settings.write_files, writes the suggestion file (key: value lines
 // plus the report) and beside it the list of vertices only a new viewpoint can cover
-// (<suggestion file stem>_new_view_vertices.txt), both atomically. Needs a mesh with normals and
-// at least one raster (InputError otherwise, as validate_input). Throws InputError when dq/sq
-// do not have one value per vertex, or when settings.viewpoint_raster is out of range.
+// (<suggestion file stem>_new_view_vertices.txt), both atomically. Suggestions learn from the
+// viewpoint's photos and, with settings.learn_from_previous, from the previous suggestion file at
+// the same path (suggest_light_learning); `recommended` is the valid suggestion promising more
+// weighted coverage that does not repeat a failed light. Needs a mesh with normals and at least
+// one raster (InputError otherwise, as validate_input). Throws InputError when dq/sq do not have
+// one value per vertex, when settings.viewpoint_raster is out of range, or when no .lp has an
+// entry for every raster.
 CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &settings, VisibilityBackend &visibility,
                             const ProgressFn &progress, const LogFn &log);
 

@@ -185,6 +185,7 @@ def main(argv=None):
     ap.add_argument("--synth", help="unused (accepted so that the CMake targets can share arguments)")
     ap.add_argument("--only", default="")
     a = ap.parse_args(argv)
+    a.work = os.path.abspath(a.work)  # the fit resolves relative paths against the project folder
     os.makedirs(a.work, exist_ok=True)
     rows = []
     for case in cases():

@@ -117,9 +117,22 @@ cv::Mat draw_scatter(const std::vector<PlotPoint> &all, const PlotOptions &o) {
     if (front[i].group == front[i + 1].group)
       cv::line(img, f.map(front[i].x, front[i].y), f.map(front[i + 1].x, front[i + 1].y), cv::Scalar(0, 0, 0), 1,
              cv::LINE_AA);
+  std::vector<cv::Rect> placed;  // labels never overlap: try a few offsets, else leave it out
   for (const PlotPoint &p : front) {
-    cv::circle(img, f.map(p.x, p.y), 9, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    if (!p.label.empty()) put(img, p.label, f.map(p.x, p.y) + cv::Point(10, -10), 0.42, cv::Scalar(60, 60, 60));
+    const cv::Point at = f.map(p.x, p.y);
+    cv::circle(img, at, 9, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    if (p.label.empty()) continue;
+    int base = 0;
+    const cv::Size size = cv::getTextSize(p.label, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, &base);
+    for (const cv::Point offset : {cv::Point(10, -10), cv::Point(10, 18), cv::Point(-size.width - 10, -10),
+                                   cv::Point(-size.width - 10, 18)}) {
+      const cv::Rect box(at + offset - cv::Point(0, size.height), cv::Size(size.width, size.height + base));
+      const bool free = std::none_of(placed.begin(), placed.end(), [&](const cv::Rect &r) { return (r & box).area() > 0; });
+      if (!free) continue;
+      put(img, p.label, at + offset, 0.42, cv::Scalar(60, 60, 60));
+      placed.push_back(box);
+      break;
+    }
   }
   // Legend to the right of the frame.
   int y = f.area.y + 10;

@@ -95,6 +95,7 @@ def main(argv=None):
     ap.add_argument("--color-correction", type=int, choices=(0, 1, 2),
                     help="colorCorrection of the fit (and so of the relighting); default: the project's fit.mlx")
     a = ap.parse_args(argv)
+    a.work = os.path.abspath(a.work)  # meshlabserver resolves relative paths against the project folder
     shutil.rmtree(a.work, ignore_errors=True)
     os.makedirs(a.work)
     project_dir = os.path.dirname(os.path.abspath(a.project))

@@ -16,7 +16,7 @@ Grid (a one-factor-at-a-time design around a reference, not the full product: th
 hours on 2 cores). Reference: synthetic scene, mesh decimated to 100k vertices, 32 photos,
 iteration cap 20. Around it: back end {gpu, cpu} x iteration cap {1,2,5,10,20,50,400}; photos
 {4,8,16,32} x back end; mesh {10k, 100k, full = 300k} x back end; CPU visibility once. Synthetic
-configurations run twice (the reference three times) and keep the fastest run. Shared
+configurations run three times, in rounds over the whole grid, and keep the fastest run. Shared
 scenes (16-bit linear photos, no colour cast) and the sample projects: photos {4,8,16,all}, caps
 {1,5,20,50,400}, GPU at the defaults, mesh decimated to 10k. Every configuration is scored on the
 held-out lights (photos never used by the fit).
@@ -193,9 +193,9 @@ def scene_grid(p, photo_counts, caps):
 def build_grid(tools, work, smoke):
     synth = synthetic_project(tools, work, smoke)
     if smoke:
-        return reference_grid(synth, "full", [3], [1, DEFAULT_CAP], ["1k"], 1, 1)
-    grid = reference_grid(synth, "100k", [4, 8, 16], CAPS, ["10k", "full"], 2, 3)
-    grid.append(Config(synth, "backend", "100k", "cpu-all", DEFAULT_CAP, 0))
+        return reference_grid(synth, "full", [3], [1, DEFAULT_CAP], ["1k"], 1, 2)
+    grid = reference_grid(synth, "100k", [4, 8, 16], CAPS, ["10k", "full"], 3, 3)
+    grid.append(Config(synth, "backend", "100k", "cpu-all", DEFAULT_CAP, 0, 2))
     for name in SHARED_SCENES:
         p = shared_project(tools, work, name)
         if p:
@@ -205,37 +205,62 @@ def build_grid(tools, work, smoke):
     return grid
 
 
-def run_config(tools, work, c):
+def run_once(tools, work, c, evaluate):
+    """One run; `evaluate` False skips the error measurements (repeats only re-measure time)."""
     p = c.project
-    cmd = [tools.bench, "fit", "--project", p.mlp, "--heldout", p.heldout, "--backend", c.backend,
-           "--iterations", str(c.iterations), "--photos", str(c.photos),
-           "--work", os.path.join(work, "runs", p.name), "--name", p.name]
-    for flag, value in (("--mesh", p.meshes[c.mesh]), ("--photo-dir", p.photo_dir), ("--gt", p.gt),
-                        ("--heldout-photo-dir", p.heldout_photo_dir), ("--albedo-factors", p.factors)):
+    cmd = [tools.bench, "fit", "--project", p.mlp, "--backend", c.backend, "--iterations", str(c.iterations),
+           "--photos", str(c.photos), "--work", os.path.join(work, "runs", p.name), "--name", p.name]
+    options = [("--mesh", p.meshes[c.mesh]), ("--photo-dir", p.photo_dir)]
+    if evaluate:
+        options += [("--heldout", p.heldout), ("--gt", p.gt), ("--heldout-photo-dir", p.heldout_photo_dir),
+                    ("--albedo-factors", p.factors)]
+    for flag, value in options:
         if value:
             cmd += [flag, value]
-    results = []
-    for _ in range(c.repeat):
-        out = run(cmd)
-        line = next(l for l in out.splitlines() if l.startswith("RESULT "))
-        results.append(json.loads(line[len("RESULT "):]))
-    # Repeated configurations keep the fastest run: other jobs on the shared machine only ever add
-    # time (the errors are the same in every run; the spread is kept as t_total_max).
-    results.sort(key=lambda r: r["t_total"])
-    row = dict(results[0])
-    row.update(scene=p.name, axis=c.axis, mesh=c.mesh, repeats=c.repeat, t_total_max=results[-1]["t_total"])
-    return row
+    out = run(cmd)
+    line = next(l for l in out.splitlines() if l.startswith("RESULT "))
+    return json.loads(line[len("RESULT "):])
+
+
+def run_grid(tools, work, configs):
+    """Runs every configuration `repeat` times, in rounds (round k runs every configuration that
+    wants k+1 runs), so that the repeats of one configuration fall at different times. Keeps the
+    fastest run: other jobs on the shared machine only ever add time (the errors are the same in
+    every run; the slowest total is kept as t_total_max)."""
+    runs = [[] for _ in configs]
+    total = sum(c.repeat for c in configs)
+    done = 0
+    for round_index in range(max(c.repeat for c in configs)):
+        for i, c in enumerate(configs):
+            if c.repeat <= round_index:
+                continue
+            runs[i].append(run_once(tools, work, c, evaluate=round_index == 0))
+            done += 1
+            r = runs[i][-1]
+            errors = f"relit dE {r['relit_mean']:.3f} / p95 {r['relit_p95']:.2f}" if round_index == 0 else "(timing)"
+            log(f"[{done}/{total}] {c.project.name:26s} {c.backend} it{c.iterations} p{r['photos']} {c.mesh:5s} "
+                f"total {r['t_total']:7.2f} s (fit {r['t_fit']:.2f}) {errors}")
+    rows = []
+    for c, results in zip(configs, runs):
+        row = dict(results[0])  # errors from the first (evaluated) run
+        fastest = min(results, key=lambda r: r["t_total"])
+        row.update({k: v for k, v in fastest.items() if k.startswith("t_") and k != "t_eval"})
+        row.update(scene=c.project.name, axis=c.axis, mesh=c.mesh, repeats=c.repeat,
+                   t_total_max=max(r["t_total"] for r in results))
+        rows.append(row)
+    return rows
 
 
 # ---------------------------------------------------------------------------------------------
 # Analysis
 
-def pareto(rows, x="t_total", y="relit_mean"):
-    """Marks rows not dominated in (time, error): no other row is at least as fast and as good."""
+def pareto(rows, x="t_total", y="relit_mean", resolution=0.005):
+    """Marks rows not dominated in (time, error): no faster row is as good. Errors closer than
+    `resolution` (relative, at least 0.005 CIEDE2000) count as equal."""
     ordered = sorted(rows, key=lambda r: (r[x], r[y]))
     best = math.inf
     for r in ordered:
-        r["pareto"] = 1 if r[y] < best else 0
+        r["pareto"] = 1 if best == math.inf or r[y] < best - max(0.005, resolution * best) else 0
         best = min(best, r[y])
 
 
@@ -249,6 +274,20 @@ def write_csv(rows, path):
         w.writeheader()
         for r in rows:
             w.writerow({k: (f"{r[k]:.6g}" if isinstance(r.get(k), float) else r.get(k, "")) for k in CSV_COLUMNS})
+
+
+def read_csv(path):
+    """Rows of a results.csv with numbers as numbers."""
+    def value(v):
+        try:
+            return int(v)
+        except ValueError:
+            try:
+                return float(v)
+            except ValueError:
+                return v
+    with open(path, encoding="utf-8") as f:
+        return [{k: value(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
 def plot(tools, rows, path, title, series, group, labels):
@@ -381,26 +420,26 @@ def main(argv=None):
     ap.add_argument("--out", required=True, help="folder for results.csv, plots, summary.md")
     ap.add_argument("--smoke", action="store_true", help="tiny grid for ctest")
     ap.add_argument("--only", default="", help="run only configurations of scenes containing this text")
+    ap.add_argument("--from-csv", default="", help="no runs: redo the plots and summary.md from a results.csv")
     a = ap.parse_args(argv)
+    a.work, a.out = os.path.abspath(a.work), os.path.abspath(a.out)
     os.makedirs(a.out, exist_ok=True)
     start = time.time()
-    grid = build_grid(a, a.work, a.smoke)
-    grid = [c for c in grid if a.only in c.project.name]
-    seen, unique = set(), []
-    for c in grid:  # the reference configuration appears on several axes
-        if c.key() not in seen:
-            seen.add(c.key())
-            unique.append(c)
-    log(f"{len(unique)} configurations (data ready after {time.time() - start:.0f} s)")
-    rows = []
-    for i, c in enumerate(unique):
-        row = run_config(a, a.work, c)
-        rows.append(row)
-        log(f"[{i + 1}/{len(unique)}] {c.project.name:26s} {short(row):28s} total {row['t_total']:7.2f} s "
-            f"(fit {row['t_fit']:.2f}) relit dE {row['relit_mean']:.3f} / p95 {row['relit_p95']:.2f}")
+    if a.from_csv:
+        rows = read_csv(a.from_csv)
+    else:
+        grid = build_grid(a, a.work, a.smoke)
+        grid = [c for c in grid if a.only in c.project.name]
+        seen, unique = set(), []
+        for c in grid:  # the reference configuration appears on several axes
+            if c.key() not in seen:
+                seen.add(c.key())
+                unique.append(c)
+        log(f"{len(unique)} configurations (data ready after {time.time() - start:.0f} s)")
+        rows = run_grid(a, a.work, unique)
     for scene in {r["scene"] for r in rows}:
         pareto([r for r in rows if r["scene"] == scene])
-    write_csv(rows, os.path.join(a.out, "results.csv"))
+    write_csv(rows, os.path.join(a.out, "results.csv"))  # with --from-csv: the Pareto column redone
     synth = [r for r in rows if r["scene"] == "synthetic"]
     if synth:
         plot(a, synth, os.path.join(a.out, "time_vs_error.png"),

@@ -2,7 +2,9 @@
 // (everything after the samples: classes, needs with the prediction failures of the photos taken,
 // the diffuse and the specular suggestion learning from those photos, the vertices that need a new
 // viewpoint), on a bumpy sphere seen by one camera with `--photos` lights already taken.
-//   bench_suggestion [--max-vertices 2000000] [--photos 12] [--csv out.csv]
+//   bench_suggestion [--max-vertices 2000000] [--photos 12] [--shadowed-above 0.5] [--csv out.csv]
+// --shadowed-above Y: vertices above height Y never get a sample (as if in cast shadow), so that
+// the predictions of every photo fail there (the learning suggestions' worst case: lower Y).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -34,9 +36,10 @@ MeshData bumpy_sphere(size_t target_vertices) {
 }
 
 // Counts as if `lights` had been photographed: covered where predicted, except a band of vertices
-// (y > 0.5) in "cast shadow" for every light, so that the predictions there fail.
+// (y > shadowed_above) in "cast shadow" for every light, so that the predictions there fail.
 std::vector<CoverageCounts> simulated_counts(const MeshData &m, const Shot &shot,
-                                             const std::vector<std::array<float, 3>> &lights, std::vector<uint8_t> &visible) {
+                                             const std::vector<std::array<float, 3>> &lights, float shadowed_above,
+                                             std::vector<uint8_t> &visible) {
   const size_t n = m.positions.size() / 3;
   std::vector<CoverageCounts> counts(n);
   visible.assign(n, 0);
@@ -51,7 +54,7 @@ std::vector<CoverageCounts> simulated_counts(const MeshData &m, const Shot &shot
     if (nrm[0] * e[0] + nrm[1] * e[1] + nrm[2] * e[2] <= 0.05f) continue;
     visible[v] = 1;
     counts[v].seen = uint16_t(lights.size());
-    if (p[1] > 0.5f) continue;  // shadowed band
+    if (p[1] > shadowed_above) continue;  // shadowed band
     for (const auto &light : lights) {
       counts[v].diffuse += light_covers_diffuse(nrm, e, light.data(), s);
       counts[v].specular += light_covers_specular(nrm, e, light.data(), s);
@@ -64,12 +67,14 @@ std::vector<CoverageCounts> simulated_counts(const MeshData &m, const Shot &shot
 int main(int argc, char **argv) {
   size_t max_vertices = 2000000;
   int photos = 12;
+  float shadowed_above = 0.5f;
   std::string csv;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--max-vertices") max_vertices = std::stoul(argv[i + 1]);
     if (a == "--photos") photos = std::stoi(argv[i + 1]);
     if (a == "--csv") csv = argv[i + 1];
+    if (a == "--shadowed-above") shadowed_above = std::stof(argv[i + 1]);
   }
   const float eye[3] = {0, 0, 6}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
   Viewpoint vp;
@@ -94,7 +99,7 @@ int main(int argc, char **argv) {
     const MeshData mesh = bumpy_sphere(n);
     const MeshView view = mesh.view();
     std::vector<uint8_t> visible;
-    const std::vector<CoverageCounts> counts = simulated_counts(mesh, vp.shot, lights, visible);
+    const std::vector<CoverageCounts> counts = simulated_counts(mesh, vp.shot, lights, shadowed_above, visible);
     std::vector<uint8_t> classes(counts.size());
     for (size_t v = 0; v < counts.size(); ++v) classes[v] = classify_coverage(counts[v]);
 
