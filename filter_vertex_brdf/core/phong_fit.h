@@ -42,7 +42,7 @@ struct PhongFitOptions {
   float alpha_init = 10.0f;      // initial shininess (thesis default)
   float alpha_min = 1.0f;        // bounds on shininess
   float alpha_max = 2000.0f;
-  int max_iterations = 20;       // alpha steps (0 = initial estimate only)
+  int max_iterations = 50;       // alpha steps (0 = initial estimate only); 50 = the knee (tests/benchmark)
   float tolerance = 1e-5f;       // relative objective improvement that counts as converged
   int min_specular_samples = 2;  // k_s and alpha are free with this many highlight samples (R.E > T_s)
   float lobe_threshold = 0.5f;   // ... or with min_lobe_samples samples with R.E above this

@@ -160,7 +160,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   params.addParam(RichFloat(kInitialShininess, 10.0f, "Initial shininess",
                             "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
                             "the highlight samples and keeps the better one). Range [1, 2000]."));
-  params.addParam(RichInt(kMaxIterations, 20, "Max iterations",
+  params.addParam(RichInt(kMaxIterations, 50, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
   params.addParam(RichInt(kMinSpecularSamples, 2, "Min specular samples",

@@ -300,7 +300,7 @@ FitSettings settings_for(const Args &a, const std::string &work, const std::stri
     throw InputError("--backend must be gpu, cpu or cpu-all (got '" + backend + "')");
   s.fit_backend = backend == "gpu" ? FitBackendChoice::GPU : FitBackendChoice::CPU;
   s.visibility_choice = backend == "cpu-all" ? VisibilityChoice::CPU : VisibilityChoice::GL;
-  s.phong.max_iterations = std::stoi(a.get("iterations", "20"));
+  if (!a.get("iterations").empty()) s.phong.max_iterations = std::stoi(a.get("iterations"));  // else the filter's default
   s.light_file = lp;
   s.output_ply = join_path(work, "fit.ply");
   return s;
