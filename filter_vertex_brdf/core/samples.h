@@ -57,6 +57,11 @@ struct GatherSettings {
   float saturation_level = 0.99f;    // fraction of the maximum code value counted as clipped
   size_t photo_cache_bytes = size_t(2) << 30;  // decoded photos kept in memory
   size_t chunk_sample_bytes = size_t(256) << 20; // target size of one chunk's samples
+  // Where a vertex's 2x2 bilinear footprint straddles a depth jump (silhouette, contact), take
+  // the colour from the footprint texels on the vertex's own surface, re-weighted (the fit's
+  // choice). false: plain bilinear over all 4 texels, mixed or not (the RTI evaluation protocol:
+  // held-out photos are compared as sampled, contamination included).
+  bool own_surface_texels = true;
 };
 
 // Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
