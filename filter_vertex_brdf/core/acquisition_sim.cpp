@@ -221,7 +221,7 @@ CandidateSet gather_candidates(const MeshView &mesh, const std::vector<Raster> &
       mesh, rasters, lights_world, visibility, [&](float f, const char *s) { return !progress || progress(0.5f * f, s); });
   set.words = masks.words();
   set.visible.assign(mesh.vertex_count, 0);
-  for (size_t v = 0; v < mesh.vertex_count; ++v) set.visible[v] = masks.is_seen(0, v) && !masks.is_mixed(0, v);
+  for (size_t v = 0; v < mesh.vertex_count; ++v) set.visible[v] = masks.is_seen(0, v) && masks.own_texels(0, v) != 0;
   set.diffuse.assign(set.words * rasters.size(), 0);
   set.specular.assign(set.words * rasters.size(), 0);
   PhotoCache photos(gather.encoding, gather.saturation_level, gather.photo_cache_bytes);

@@ -143,11 +143,12 @@ void report_progress(const ProgressFn &progress, float fraction, const char *sta
   if (progress && !progress(fraction, stage)) throw ProcessingError("cancelled by the user");
 }
 
-// seen and clean (no mixed pixel) in the viewpoint's first raster: where its photos can give samples.
+// seen with some own-surface footprint texel (samples.h: kRimFootprint) in the viewpoint's first raster:
+// where its photos can give samples.
 std::vector<uint8_t> viewpoint_visible(const VisibilityMasks &masks, const Viewpoint &vp) {
   std::vector<uint8_t> visible(masks.vertex_count, 0);
   const size_t r = vp.rasters.front();
-  for (size_t v = 0; v < masks.vertex_count; ++v) visible[v] = masks.is_seen(r, v) && !masks.is_mixed(r, v);
+  for (size_t v = 0; v < masks.vertex_count; ++v) visible[v] = masks.is_seen(r, v) && masks.own_texels(r, v) != 0;
   return visible;
 }
 

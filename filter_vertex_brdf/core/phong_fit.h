@@ -52,13 +52,22 @@ struct PhongFitOptions {
   float kd_max = 16.0f;
   float ks_max = 64.0f;
   float specular_threshold = 0.9f;  // T_s: which samples are highlight samples (for DQ/SQ and counts)
+  // Fallback for vertices the strict rules leave without any usable sample (fit_vertex_weak):
+  // grazing samples (N.L < T_d) carry their N.L weight like any other, and contaminated
+  // (kMixedPixel) samples count with this weight factor.
+  float mixed_sample_weight = 0.25f;
 };
 
 enum FitStatus : uint8_t {
   kFitNone = 0,         // no usable sample: sentinels
   kFitDiffuseOnly = 1,  // k_s = 0 (not enough specular evidence)
   kFitFull = 2,         // all parameters fitted
+  kFitFromNeighbours = 3,   // no usable sample of its own: parameters from the nearest fitted
+                            //   vertices over the mesh (neighbour_fill.h); dq = sq = 0
+  kFitFromWeakSamples = 4,  // no sample passes the strict rules: fitted from grazing and/or
+                            //   contaminated (mixed-pixel) samples (fit_vertex_weak); k_s may be 0
 };
+
 
 struct VertexFit {
   float color[3];     // C, max channel 1
@@ -76,6 +85,12 @@ struct VertexFit {
 // Fits one vertex from its samples (any flags: unusable ones are skipped). Double precision.
 void fit_vertex_cpu(const Sample *samples, size_t count, const PhongFitOptions &options, VertexFit &out);
 
+// The fallback fit for a vertex without any strictly usable sample: the same model and method,
+// over every lit, unsaturated sample with N.L > 0 (grazing ones with their N.L weight, mixed-pixel
+// ones at options.mixed_sample_weight). Status kFitFromWeakSamples, or kFitNone when even these
+// are absent (all shadowed or saturated). DQ and SQ are halved: weaker evidence than a strict fit.
+void fit_vertex_weak(const Sample *samples, size_t count, const PhongFitOptions &options, VertexFit &out);
+
 // Fits every vertex of a chunk (OpenMP). `out` has chunk.vertex_count entries.
 void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out);
 
@@ -88,5 +103,8 @@ void set_diffuse_only_reflectance(const Sample *samples, size_t count, const Pho
 
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
 void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float out_rgb[3]);
+
+// True when the vertex has a reflectance model (any status but kFitNone).
+inline bool has_model(const VertexFit &fit) { return fit.status != kFitNone; }
 
 } // namespace vbrdf

@@ -185,22 +185,25 @@ void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float ou
 
 namespace {
 // The fit's usable samples (see phong_fit.h); returns the number of highlight samples.
+// `weak`: the fallback rules (fit_vertex_weak): grazing samples kept, mixed ones down-weighted.
 int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std::vector<FitSample> &samples,
-                   double &w_high, double &w_other) {
+                   double &w_high, double &w_other, bool weak = false) {
   samples.clear();
   samples.reserve(count);
   w_high = w_other = 0;
   int n_high = 0;
   for (size_t i = 0; i < count; ++i) {
     const Sample &s = in[i];
-    if ((s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) || !(s.n_dot_l > 0)) continue;
+    if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0)) continue;
+    if ((s.flags & kMixedPixel) && !weak) continue;
     // Grazing light (N.L < T_d) is as unreliable for the fit as for the basic colour (normal
     // errors, shading-model breakdown); a grazing highlight is still specular evidence.
-    if ((s.flags & kGrazing) && !(s.flags & kHighlight)) continue;
+    if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) continue;
     if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.r_dot_e) ||
         !std::isfinite(s.n_dot_l))
       continue;  // a corrupt sample is not evidence
-    FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.r_dot_e, s.n_dot_l,
+    const double w = s.n_dot_l * ((s.flags & kMixedPixel) ? double(o.mixed_sample_weight) : 1.0);
+    FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.r_dot_e, w,
                 s.r_dot_e > o.specular_threshold};
     (x.highlight ? w_high : w_other) += x.w;
     n_high += x.highlight;
@@ -222,12 +225,13 @@ void set_diffuse_only_reflectance(const Sample *in, size_t count, const PhongFit
   quality_metrics(samples, out, out);
 }
 
-void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
+namespace {
+void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool weak, VertexFit &out) {
   set_sentinels(out);
   std::vector<FitSample> samples;
   double w_high, w_other;
-  const int n_high = usable_samples(in, count, o, samples, w_high, w_other);
-  if (samples.empty()) return;
+  const int n_high = usable_samples(in, count, o, samples, w_high, w_other, weak);
+  if (samples.empty() || !(w_high + w_other > 0)) return;
   // Remedy 1: highlight samples may not outweigh the rest.
   if (w_other > 0 && w_high > o.specular_weight_cap * w_other) {
     const double scale = o.specular_weight_cap * w_other / w_high;
@@ -294,6 +298,19 @@ void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, Ve
   out.iterations = uint16_t(it);
   out.converged = converged ? 1 : 0;
   quality_metrics(samples, out, out);
+}
+} // namespace
+
+void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
+  fit_vertex(in, count, o, false, out);
+}
+
+void fit_vertex_weak(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
+  fit_vertex(in, count, o, true, out);
+  if (out.status == kFitNone) return;
+  out.status = kFitFromWeakSamples;
+  out.dq *= 0.5f;
+  out.sq *= 0.5f;
 }
 
 void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out) {

@@ -58,30 +58,38 @@ Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturati
 
 namespace {
 template <typename T>
-PixelSample bilinear(const Photo &photo, float x, float y) {
+PixelSample bilinear(const Photo &photo, float x, float y, uint8_t texels) {
   PixelSample out;
   // Pixel centres are at +0.5: shift to centre-based coordinates.
   const float fx = x - 0.5f, fy = y - 0.5f;
   const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= photo.width() || y0 + 1 >= photo.height()) return out;
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= photo.width() || y0 + 1 >= photo.height() || (texels & 0xF) == 0) return out;
   out.inside = true;
   const float ax = fx - float(x0), ay = fy - float(y0);
-  const float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+  float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+  float total = 0;
+  for (int k = 0; k < 4; ++k) total += (texels >> k & 1u) ? w[k] : (w[k] = 0);
+  if (total < 1e-3f)  // kept texels carry (almost) no bilinear weight: average them instead
+    for (int k = 0; k < 4; ++k) w[k] = (texels >> k & 1u) ? 1.0f : 0.0f;
+  total = 0;
+  for (float wk : w) total += wk;
   const T *rows[2] = {photo.pixels.ptr<T>(y0), photo.pixels.ptr<T>(y0 + 1)};
   for (int k = 0; k < 4; ++k) {
+    if (w[k] == 0 && texels != 0xF) continue;
     const T *px = rows[k / 2] + 3 * (x0 + (k % 2));
     for (int c = 0; c < 3; ++c) {
       if (int(px[c]) >= photo.saturation_code) out.saturated = true;
-      out.rgb[c] += w[k] * photo.lut[px[c]];
+      out.rgb[c] += w[k] / total * photo.lut[px[c]];
     }
   }
   return out;
 }
 } // namespace
 
-PixelSample sample_bilinear(const Photo &photo, float x, float y) {
+PixelSample sample_bilinear(const Photo &photo, float x, float y, uint8_t texels) {
   if (!std::isfinite(x) || !std::isfinite(y)) return PixelSample();
-  return photo.pixels.depth() == CV_16U ? bilinear<uint16_t>(photo, x, y) : bilinear<uint8_t>(photo, x, y);
+  return photo.pixels.depth() == CV_16U ? bilinear<uint16_t>(photo, x, y, texels)
+                                        : bilinear<uint8_t>(photo, x, y, texels);
 }
 
 PhotoCache::PhotoCache(PhotoEncoding encoding, float saturation_level, size_t budget_bytes)

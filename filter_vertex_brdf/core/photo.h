@@ -3,6 +3,7 @@
 // 8-bit photos are sRGB-encoded (camera JPEG/PNG) and decoded with the sRGB EOTF; 16-bit PNG/TIFF
 // are taken as linear. Pixels are kept in their original 8/16-bit form (a 256/65536-entry table
 // decodes on sampling) so that hundreds of photos fit in memory.
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -40,7 +41,11 @@ struct PixelSample {
 };
 
 // Bilinear sample at image-pixel coordinates (top-left origin, y down, centres at +0.5).
-PixelSample sample_bilinear(const Photo &photo, float x, float y);
+// `texels` (visibility.h's footprint mask: bit k = texel (x0 + k % 2, y0 + k / 2)) restricts the
+// footprint to some of its 4 texels, their bilinear weights renormalised; when those weights sum
+// to almost nothing (the point sits on the far side of the kept texels) the kept texels are
+// averaged. Saturation is checked on the kept texels only. texels == 0 gives inside = false.
+PixelSample sample_bilinear(const Photo &photo, float x, float y, uint8_t texels = 0xF);
 
 // Keeps decoded photos under a memory budget (least recently used are dropped and reloaded on
 // demand). Thread-safe.

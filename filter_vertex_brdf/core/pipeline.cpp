@@ -316,7 +316,30 @@ void consume_chunk(const SampleChunk &chunk, PhongFitter *fitter, const PhongFit
       set_diffuse_only_reflectance(chunk.samples.data() + chunk.offsets[i], chunk.offsets[i + 1] - chunk.offsets[i],
                                    options, e.rgb, f);
   }
+  // Vertices the strict rules left without a sample (all grazing, all mixed): the fallback fit
+  // from what there is, on the CPU for either back end (few vertices, and one code path).
+#pragma omp parallel for schedule(dynamic, 64)
+  for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
+    VertexFit &f = r.fits[chunk.first_vertex + size_t(i)];
+    const uint32_t begin = chunk.offsets[size_t(i)], end = chunk.offsets[size_t(i) + 1];
+    if (f.status == kFitNone && end > begin) fit_vertex_weak(chunk.samples.data() + begin, end - begin, options, f);
+  }
   fit_seconds += seconds_since(t);
+}
+
+// Seen vertices still without a model (every sample shadowed or saturated) and, on request, small
+// unseen gaps take the parameters of their nearest modelled neighbours (neighbour_fill.h).
+void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &log, FitResult &r) {
+  const size_t n = input.mesh.vertex_count;
+  std::vector<uint8_t> seen(n);
+  for (size_t v = 0; v < n; ++v) seen[v] = r.diffuse[v].n_seen > 0;
+  r.fill = fill_from_neighbours(input.mesh, seen.data(), settings.fill_unseen_rings, r.fits.data());
+  if (r.fill.filled_seen || r.fill.filled_unseen)
+    log("Neighbour fill: " + std::to_string(r.fill.filled_seen) + " seen vertices without a usable sample and " +
+        std::to_string(r.fill.filled_unseen) + " unseen vertices took their neighbours' parameters (fit_status 3).");
+  if (r.fill.unreachable_seen)
+    log("Neighbour fill: " + std::to_string(r.fill.unreachable_seen) +
+        " seen vertices have no usable sample and no modelled vertex in their part of the mesh: left without a model.");
 }
 
 // Linear diffuse reflectance shown and written: the fitted k_d C where the Phong fit has samples,
@@ -347,8 +370,10 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     const bool coloured = displayed_reflectance(r, v, rho);
     for (int c = 0; c < 3; ++c) attr(size_t(c))[v] = rho[c];
     attr(3)[v] = e.n_seen, attr(4)[v] = e.n_diffuse, attr(5)[v] = e.n_specular;
-    const bool mixed = e.from_mixed_pixels && (r.fits.empty() || r.fits[v].status == kFitNone);
-    attr(6)[v] = coloured ? (mixed ? 2.0f : 1.0f) : 0.0f;
+    const bool mixed = r.fits.empty() ? e.from_mixed_pixels
+                                      : (r.fits[v].status == kFitFromWeakSamples && e.from_mixed_pixels);
+    const bool from_neighbours = !r.fits.empty() && r.fits[v].status == kFitFromNeighbours;
+    attr(6)[v] = coloured ? (from_neighbours ? 3.0f : mixed ? 2.0f : 1.0f) : 0.0f;
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
       const float values[] = {f.kd, f.ks, f.shininess, f.color[0], f.color[1], f.color[2], f.dq, f.sq, f.rmse,
@@ -356,6 +381,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       for (size_t k = 0; k < 11; ++k) attr(7 + k)[v] = values[k];
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
+      r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
       r.fit_converged += f.status == kFitFull && f.converged, r.fit_iterations += f.iterations;
     }
     if (coloured) {
@@ -405,7 +431,9 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
         << "  diffuse-only (k_s = 0; k_s/alpha stages skipped: fewer than " << settings.phong.min_specular_samples
         << " clean highlight samples and fewer than " << settings.phong.min_lobe_samples
         << " samples with R.E > " << settings.phong.lobe_threshold << ", or no specular term): " << r.fit_diffuse_only << "\n"
-        << "  no usable sample (sentinels: k_d = k_s = shininess = 0): " << r.fit_none << "\n"
+        << "  from weak samples only (grazing N.L < T_d and/or mixed pixels; fit_status 4): " << r.fit_weak << "\n"
+        << "  from neighbours (no usable sample of their own; fit_status 3): " << r.fit_neighbours << "\n"
+        << "  no model (sentinels: k_d = k_s = shininess = 0; unseen, or no modelled neighbour): " << r.fit_none << "\n"
         << "  converged before the cap of " << settings.phong.max_iterations << " iterations: " << r.fit_converged
         << " of " << r.fit_full << " full fits; alpha iterations run: " << r.fit_iterations << " of at most "
         << uint64_t(r.fit_full + r.fit_diffuse_only) * uint64_t(std::max(0, settings.phong.max_iterations)) << "\n";
@@ -508,6 +536,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
       gather_progress);
   result.seconds_gather = seconds_since(t);
   result.colors = std::move(colors.viewpoints);
+  if (settings.fit_reflectance) fill_gaps(input, settings, log, result);
 
   t = Clock::now();
   build_outputs(input, settings, result);

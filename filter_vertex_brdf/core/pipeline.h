@@ -11,6 +11,7 @@
 
 #include "color_chart.h"
 #include "diffuse_color.h"
+#include "neighbour_fill.h"
 #include "phong_fit.h"
 #include "mesh_view.h"
 #include "output_ply.h"
@@ -43,6 +44,9 @@ struct FitSettings {
   ExposureMode exposure = ExposureMode::Auto;  // per-photo normalisation by the chart's neutrals
   std::string light_file;   // "" = search beside the project, then beside the images
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
+  // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
+  // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.
+  int fill_unseen_rings = 0;
 };
 
 struct FitInput {
@@ -79,6 +83,8 @@ struct FitResult {
   std::string visibility_backend;         // name of the back end that ran
   std::string fit_backend;                // name of the fit back end ("" when not fitted)
   size_t fit_full = 0, fit_diffuse_only = 0, fit_none = 0, fit_converged = 0, fit_iterations = 0;
+  size_t fit_weak = 0, fit_neighbours = 0;  // fit_status 4 and 3
+  NeighbourFillStats fill;
   double seconds_fit = 0;
   std::string light_file;                 // the .lp used
   std::vector<ColorCalibration> colors;   // per viewpoint (rasters_by_viewpoint order); empty when Off

@@ -47,6 +47,14 @@ bool VisibilityMasks::sees_any(size_t r, size_t first, size_t count) const {
   return false;
 }
 
+uint8_t VisibilityMasks::own_texels(size_t r, size_t v) const {
+  if (!is_mixed(r, v)) return kAllFootprintTexels;
+  if (r >= footprints.size()) return 0;  // masks built without footprint lists: nothing known
+  const std::vector<uint32_t> &list = footprints[r];
+  const auto it = std::lower_bound(list.begin(), list.end(), uint32_t(v) << 4);
+  return (it != list.end() && (*it >> 4) == v) ? uint8_t(*it & 0xFu) : uint8_t(0);
+}
+
 namespace {
 // Combines the camera pass with the per-vertex frustum and facing tests into `seen`, counting why
 // vertices are not seen (off image first, then back-facing, then occluded).
@@ -77,13 +85,24 @@ void classify_seen(const MeshView &mesh, const Raster &raster, const std::vector
         continue;
       }
       bits |= uint64_t(1) << (v % 64);
-      if (clear[v] == 2) mixed_bits |= uint64_t(1) << (v % 64);
+      if (clear[v] & kFootprintPartial) mixed_bits |= uint64_t(1) << (v % 64);
       ++seen;
     }
     seen_words[w] = bits;
     mixed_words[w] = mixed_bits;
   }
   counts[0] = uint32_t(off), counts[1] = uint32_t(back), counts[2] = uint32_t(occ), counts[3] = uint32_t(seen);
+}
+
+// The sorted (v << 4 | own-texel mask) list of the vertices marked in `mixed_words`.
+std::vector<uint32_t> footprint_list(const std::vector<uint8_t> &clear, const uint64_t *mixed_words, size_t words) {
+  std::vector<uint32_t> list;
+  for (size_t w = 0; w < words; ++w)
+    for (uint64_t bits = mixed_words[w]; bits; bits &= bits - 1) {
+      const size_t v = w * 64 + size_t(__builtin_ctzll(bits));
+      list.push_back(uint32_t(v) << 4 | (clear[v] & 0xFu));
+    }
+  return list;
 }
 } // namespace
 
@@ -96,6 +115,9 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
   masks.seen.assign(masks.words() * rasters.size(), 0);
   masks.lit.assign(masks.words() * rasters.size(), 0);
   masks.mixed.assign(masks.words() * rasters.size(), 0);
+  masks.footprints.assign(rasters.size(), {});
+  if (mesh.vertex_count >= (size_t(1) << 28))
+    throw InputError("Meshes of more than 268 million vertices are not supported.");
   for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded, &masks.seen_count}) v->assign(rasters.size(), 0);
   std::vector<uint8_t> buffer(mesh.vertex_count);
   for (size_t r = 0; r < rasters.size(); ++r) {
@@ -106,6 +128,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
     classify_seen(mesh, rasters[r], buffer, &masks.seen[r * masks.words()], &masks.mixed[r * masks.words()], counts);
     masks.off_image[r] = counts[0], masks.back_facing[r] = counts[1], masks.occluded[r] = counts[2];
     masks.seen_count[r] = counts[3];
+    masks.footprints[r] = footprint_list(buffer, &masks.mixed[r * masks.words()], masks.words());
     if (counts[3] == 0) continue;  // a photo that sees nothing needs no shadow pass
     std::fill(buffer.begin(), buffer.end(), 0);
     backend.light_pass(light_dirs_world[r].data(), buffer.data());
@@ -117,7 +140,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
 
 uint16_t make_sample(const float position[3], const float normal_in[3], const Raster &raster, uint16_t raster_index,
                      const float light_dir[3], const Photo &photo, bool camera_clear, bool light_clear,
-                     const GatherSettings &settings, Sample &out) {
+                     const GatherSettings &settings, Sample &out, uint8_t own_texels) {
   out = Sample{{0, 0, 0}, 0, 0, raster_index, 0};
   float n[3] = {normal_in[0], normal_in[1], normal_in[2]};
   normalize3(n);
@@ -144,7 +167,11 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
   if (d > 0 && s > settings.specular_threshold) flags |= kHighlight;
 
   if (!(flags & kNotSeen)) {
-    const PixelSample px = sample_bilinear(photo, ip.x, ip.y);
+    own_texels &= kAllFootprintTexels;
+    const bool partial = own_texels != kAllFootprintTexels;
+    const bool own_only = partial && settings.own_surface_texels && own_texels != 0;
+    if (partial) flags |= own_only ? kRimFootprint : kMixedPixel;
+    const PixelSample px = sample_bilinear(photo, ip.x, ip.y, own_only ? own_texels : kAllFootprintTexels);
     if (!px.inside) flags |= kOffImage;  // bilinear footprint crosses the image border
     if (px.saturated) flags |= kSaturated;
     for (int c = 0; c < 3; ++c) out.rgb[c] = px.rgb[c];
@@ -191,8 +218,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
           continue;
         }
         make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo, true,
-                    masks.is_lit(r, v), settings, out);
-        if (masks.is_mixed(r, v)) out.flags |= kMixedPixel;
+                    masks.is_lit(r, v), settings, out, masks.own_texels(r, v));
       }
     }
     // Compact: keep samples seen by the camera, in vertex order.

@@ -27,7 +27,10 @@ enum SampleFlag : uint16_t {
   kSaturated = 1u << 5,       // a channel is clipped in the bilinear footprint
   kGrazing = 1u << 6,         // 0 < N.L < T_d
   kHighlight = 1u << 7,       // R.E > T_s (specular sample)
-  kMixedPixel = 1u << 8,      // the pixel footprint also covers background/another surface
+  kMixedPixel = 1u << 8,      // the pixel footprint also covers background/another surface, and
+                              //   the colour includes it (no own-surface texel, or plain bilinear)
+  kRimFootprint = 1u << 9,    // the footprint straddles a depth jump; the colour comes from its
+                              //   own-surface texels only (GatherSettings::own_surface_texels)
 };
 constexpr uint16_t kNotSeen = kOffImage | kBackFacing | kOccluded;
 constexpr uint16_t kShadowed = kAttachedShadow | kCastShadow;
@@ -72,12 +75,17 @@ struct VisibilityMasks {
   size_t raster_count = 0;
   std::vector<uint64_t> seen;  // raster-major: word (r * words() + v / 64), bit v % 64
   std::vector<uint64_t> lit;
-  std::vector<uint64_t> mixed;  // seen, but the pixel footprint mixes surfaces (GL back end only)
+  std::vector<uint64_t> mixed;  // seen, but the pixel footprint straddles a depth jump
+  // Per raster, for its mixed vertices only, sorted: (v << 4) | mask of the footprint texels on the
+  // vertex's own surface (visibility.h). Sparse: only rims and contacts are listed.
+  std::vector<std::vector<uint32_t>> footprints;
   std::vector<uint32_t> off_image, back_facing, occluded, seen_count;  // per raster
   size_t words() const { return (vertex_count + 63) / 64; }
   bool is_seen(size_t r, size_t v) const { return (seen[r * words() + v / 64] >> (v % 64)) & 1u; }
   bool is_lit(size_t r, size_t v) const { return (lit[r * words() + v / 64] >> (v % 64)) & 1u; }
   bool is_mixed(size_t r, size_t v) const { return (mixed[r * words() + v / 64] >> (v % 64)) & 1u; }
+  // Own-surface texels of the footprint of vertex v in raster r: kAllFootprintTexels unless mixed.
+  uint8_t own_texels(size_t r, size_t v) const;
   // True when raster r sees at least one vertex in [first, first + count).
   bool sees_any(size_t r, size_t first, size_t count) const;
 };
@@ -93,11 +101,15 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
                                    VisibilityBackend &backend, const ProgressFn &progress = {});
 
 // Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`.
-// `camera_clear`/`light_clear` come from the depth passes (occlusion / cast shadow). Returns the flags; when the result
-// has any kNotSeen flag, `out` holds only flags and geometry terms.
+// `camera_clear`/`light_clear` come from the depth passes (occlusion / cast shadow);
+// `own_texels` is the footprint mask of the camera pass (kAllFootprintTexels: a clean footprint).
+// A partial footprint gives kRimFootprint and the own texels' colour when
+// settings.own_surface_texels and any own texel remains, else kMixedPixel and the plain bilinear
+// colour. Returns the flags; when the result has any kNotSeen flag, `out` holds only flags and
+// geometry terms.
 uint16_t make_sample(const float position[3], const float normal[3], const Raster &raster, uint16_t raster_index,
                      const float light_dir_world[3], const Photo &photo, bool camera_clear, bool light_clear,
-                     const GatherSettings &settings, Sample &out);
+                     const GatherSettings &settings, Sample &out, uint8_t own_texels = kAllFootprintTexels);
 
 struct SampleChunk {
   uint32_t first_vertex = 0;

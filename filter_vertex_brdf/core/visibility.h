@@ -27,15 +27,39 @@ struct VisibilitySettings {
 // spacing; finer maps cost time, quadratically, and change few vertices' flags). Throws InputError when negative.
 int resolved_shadow_map_size(const MeshView &mesh, const VisibilitySettings &settings);
 
+// Camera-pass output codes (VisibilityBackend::camera_pass).
+constexpr uint8_t kCameraHidden = 0;
+constexpr uint8_t kCameraClear = 1;
+constexpr uint8_t kFootprintPartial = 0x10;  // | 4-bit mask of own-surface footprint texels
+constexpr uint8_t kAllFootprintTexels = 0xF;
+
+// The bilinear footprint of image point (x, y) (image pixels, top-left origin, centres at +0.5)
+// is the 2x2 block whose top-left texel is (floor(x - 0.5), floor(y - 0.5)). Bit k of a footprint
+// mask stands for texel (x0 + k % 2, y0 + k / 2).
+inline uint8_t footprint_texel_bit(int k) { return uint8_t(1u << k); }
+
+// How far a texel's surface depth may differ from the vertex's depth and still count as the
+// vertex's own (continuous) surface: across 1.5 texels the depth of a surface seen at up to 79
+// degrees from the view axis (slope tan = 5) changes by 1.5 * 5 * (world size of a texel), plus
+// the depth tolerance. Creases and steep faces stay own surface; background and separate
+// surfaces (depth jumps) do not.
+inline float own_surface_depth_slack(float vertex_depth, float focal_px, float tolerance) {
+  return tolerance + 1.5f * vertex_depth / focal_px * 5.0f;
+}
+
 class VisibilityBackend {
 public:
   virtual ~VisibilityBackend() = default;
   virtual const char *name() const = 0;
-  // out[v] = 1 when no other geometry hides vertex v from the camera of `shot`, else 0;
-  // 2 when it is not hidden but the 2x2 pixel footprint of its bilinear colour sample also
-  // covers background or another surface (a mixed pixel at a silhouette or mesh border: the
-  // colour is contaminated). Only back ends with a depth map report 2 (GL); the CPU ray caster
-  // reports 1. Vertices outside the image or behind the camera get 1 (not this pass's concern).
+  // out[v] = kCameraHidden when other geometry hides vertex v from the camera of `shot`;
+  // kCameraClear when it is not hidden and every texel of the 2x2 footprint of its bilinear colour
+  // sample shows the vertex's own surface; kFootprintPartial | mask when it is not hidden but the
+  // footprint straddles a depth jump (silhouette, mesh border, contact with another surface):
+  // `mask` (footprint_texel_bit) marks the texels that still show the vertex's own surface, 0 when
+  // none does. A texel is "own surface" when the first surface along its pixel ray lies within
+  // own_surface_depth_slack of the vertex's depth. Vertices outside the image or behind the camera
+  // get kCameraClear (not this pass's concern). Both back ends implement the footprint test (GL
+  // from its depth map, the CPU by casting the 4 texel rays).
   virtual void camera_pass(const Shot &shot, uint8_t *out) = 0;
   // out[v] = 1 when no geometry lies between vertex v and a directional light shining from
   // `dir_world` (unit vector towards the light), else 0 (cast shadow).

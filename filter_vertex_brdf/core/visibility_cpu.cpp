@@ -1,5 +1,6 @@
-// CPU reference for the visibility contract (visibility.h): one ray per vertex and pass, traced
-// through a vcglib uniform grid over the triangles. Slow but exact up to floating point; the GL
+// CPU reference for the visibility contract (visibility.h): one ray per vertex and pass (plus, for
+// a vertex the camera sees, one per texel of its bilinear footprint), traced through a vcglib
+// uniform grid over the triangles. Slow but exact up to floating point; the GL
 // passes are tested against it.
 //
 // Why the offset: a ray starting exactly on the vertex hits the vertex's own triangles at t ~ 0
@@ -17,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -110,6 +112,12 @@ public:
 private:
   // True when a triangle lies on the ray from `from` along unit `dir` within (0, max_dist].
   bool blocked(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist);
+  // Distance to the first triangle along the ray within max_dist, or +infinity when none.
+  float first_hit(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist);
+  // kCameraClear or kFootprintPartial | mask for a visible vertex (visibility.h): one ray per
+  // footprint texel centre, own surface when its first hit lies within the depth slack.
+  uint8_t footprint_code(MarkState &marks, const Shot &shot, const vcg::Point3f &centre, const ImagePoint &ip,
+                         float vertex_depth, float focal_px);
 
   MeshView mesh_;
   float tolerance_ = 0;
@@ -145,6 +153,37 @@ bool CpuVisibility::blocked(MarkState &marks, const vcg::Point3f &from, const vc
   return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) != nullptr;
 }
 
+float CpuVisibility::first_hit(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist) {
+  if (triangles_.empty() || !(max_dist > 0)) return std::numeric_limits<float>::infinity();
+  RayTriangleHit hit;
+  StampMarker marker(&marks, triangles_.data());
+  float t = 0;
+  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) ? t
+                                                                                 : std::numeric_limits<float>::infinity();
+}
+
+uint8_t CpuVisibility::footprint_code(MarkState &marks, const Shot &shot, const vcg::Point3f &centre,
+                                      const ImagePoint &ip, float vertex_depth, float focal_px) {
+  const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
+  const int x0 = int(std::floor(ip.x - 0.5f)), y0 = int(std::floor(ip.y - 0.5f));
+  const float slack = own_surface_depth_slack(vertex_depth, focal_px, tolerance_);
+  uint8_t mask = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int i = x0 + k % 2, j = y0 + k / 2;
+    if (i < 0 || j < 0 || i >= width || j >= height) continue;
+    // A point on the texel's pixel ray (VCG pixels: y up), at the vertex's depth.
+    const vcg::Point3f on_ray = shot.UnProject(vcg::Point2f(float(i) + 0.5f, float(height - j) - 0.5f), vertex_depth);
+    vcg::Point3f dir = on_ray - centre;
+    const float len = dir.Norm();
+    if (!(len > 0)) continue;
+    dir /= len;
+    // Depth along the view axis scales with distance along the ray by vertex_depth / len.
+    const float t = first_hit(marks, centre, dir, 2 * (len + diagonal_));
+    if (std::isfinite(t) && std::fabs(t * vertex_depth / len - vertex_depth) <= slack) mask |= footprint_texel_bit(k);
+  }
+  return mask == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | mask);
+}
+
 void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
   if (!shot_is_valid(shot))
     throw InputError("CPU visibility: the camera of the raster is not valid (zero focal length, pixel size, "
@@ -153,6 +192,7 @@ void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
   camera_centre(shot, c);
   const vcg::Point3f centre(c[0], c[1], c[2]);
   const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
+  const float focal_px = shot.Intrinsics.FocalMm / shot.Intrinsics.PixelSizeMm[0];
   const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
 #pragma omp parallel
   {
@@ -171,7 +211,11 @@ void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
       const float dist = dir.Norm();
       dir /= dist;
       // Segment from the offset start to the camera centre.
-      out[v] = blocked(marks, pos + dir * tolerance_, dir, dist - tolerance_) ? 0 : 1;
+      if (blocked(marks, pos + dir * tolerance_, dir, dist - tolerance_)) {
+        out[v] = kCameraHidden;
+        continue;
+      }
+      out[v] = footprint_code(marks, shot, centre, ip, view_depth(shot, p), focal_px);
     }
   }
 }

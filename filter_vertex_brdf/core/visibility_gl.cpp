@@ -64,17 +64,19 @@ inline bool depth_clear(const float *map, int w, int h, float wx, float wy, floa
   return depth <= far_depth + tol;
 }
 
-// True when every texel of the 2x2 footprint shows the vertex's own surface: its depth within
-// `allowed` of the vertex depth. A footprint that also covers background or another surface gives
-// a mixed (contaminated) bilinear colour sample.
-inline bool footprint_clean(const float *map, int w, int h, float wx, float wy, float depth, float allowed) {
-  const int i0 = int(std::floor(wx - 0.5f)), j0 = int(std::floor(wy - 0.5f));
-  for (int j = j0; j <= j0 + 1; ++j)
-    for (int i = i0; i <= i0 + 1; ++i) {
-      if (i < 0 || j < 0 || i >= w || j >= h) return false;
-      if (std::fabs(map[size_t(j) * size_t(w) + size_t(i)] - depth) > allowed) return false;
-    }
-  return true;
+// The camera-pass code of a visible vertex at image point (ix, iy) (image pixels, y down):
+// kCameraClear when every texel of its 2x2 bilinear footprint shows the vertex's own surface
+// (depth within `allowed` of the vertex depth), else kFootprintPartial | the mask of those that do
+// (visibility.h). The depth map is in GL window rows (row 0 = image row h - 1).
+inline uint8_t footprint_code(const float *map, int w, int h, float ix, float iy, float depth, float allowed) {
+  const int x0 = int(std::floor(ix - 0.5f)), y0 = int(std::floor(iy - 0.5f));
+  uint8_t mask = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int i = x0 + k % 2, row = h - 1 - (y0 + k / 2);
+    if (i < 0 || row < 0 || i >= w || row >= h) continue;
+    if (std::fabs(map[size_t(row) * size_t(w) + size_t(i)] - depth) <= allowed) mask |= footprint_texel_bit(k);
+  }
+  return mask == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | mask);
 }
 
 // An FBO with an R32F colour texture (linear depth) and a 32F depth renderbuffer.
@@ -331,12 +333,7 @@ void GlVisibility::camera_pass(const Shot &shot, uint8_t *out) {
       out[v] = 0;
       continue;
     }
-    // On the vertex's own (continuous) surface depth changes across a texel by at most about
-    // (world size of a texel) * tan(view angle); allowing the steepest useful slope (tan = 5, a
-    // 79-degree view angle) over 1.5 texels keeps creases and steep faces clean while background
-    // and separate surfaces (depth jumps) still count as mixed.
-    const float allowed = tol + 1.5f * depth / focal_px * 5.0f;
-    out[v] = footprint_clean(map, width, height, wx, wy, depth, allowed) ? 1 : 2;
+    out[v] = footprint_code(map, width, height, lp.x, lp.y, depth, own_surface_depth_slack(depth, focal_px, tol));
   }
 }
 
