@@ -945,23 +945,6 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
 
 namespace {
 
-// Identical registrations (to 1e-6 relative): photos of one viewpoint.
-bool same_shot(const Shot &a, const Shot &b) {
-  auto close = [](double x, double y) {
-    return std::fabs(x - y) <= 1e-6 * std::max(1.0, std::max(std::fabs(x), std::fabs(y)));
-  };
-  const vcg::Matrix44f ra = a.Extrinsics.Rot(), rb = b.Extrinsics.Rot();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (!close(ra[i][j], rb[i][j])) return false;
-  for (int k = 0; k < 3; ++k)
-    if (!close(a.Extrinsics.Tra()[k], b.Extrinsics.Tra()[k])) return false;
-  const auto &ia = a.Intrinsics, &ib = b.Intrinsics;
-  return close(ia.FocalMm, ib.FocalMm) && close(ia.CenterPx[0], ib.CenterPx[0]) &&
-         close(ia.CenterPx[1], ib.CenterPx[1]) && ia.ViewportPx == ib.ViewportPx &&
-         close(ia.PixelSizeMm[0], ib.PixelSizeMm[0]) && close(ia.PixelSizeMm[1], ib.PixelSizeMm[1]);
-}
-
 // Rodrigues rotation of v about the unit axis u by angle t (radians).
 vcg::Point3f rotate(const vcg::Point3f &v, const vcg::Point3f &u, float t) {
   const float c = std::cos(t), s = std::sin(t);
