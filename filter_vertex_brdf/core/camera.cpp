@@ -1,5 +1,6 @@
 #include "camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vbrdf {
@@ -11,7 +12,23 @@ vcg::Matrix44f rotation(const Shot &shot) {
   return r;
 }
 bool finite3(const vcg::Point3f &p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+bool nearly_equal(double a, double b) {
+  return std::fabs(a - b) <= 1e-6 * std::max({1.0, std::fabs(a), std::fabs(b)});
+}
 } // namespace
+
+bool same_shot(const Shot &a, const Shot &b) {
+  const auto &ia = a.Intrinsics, &ib = b.Intrinsics;
+  bool same = ia.ViewportPx == ib.ViewportPx && nearly_equal(ia.FocalMm, ib.FocalMm);
+  for (int k = 0; k < 2; ++k)
+    same = same && nearly_equal(ia.PixelSizeMm[k], ib.PixelSizeMm[k]) && nearly_equal(ia.CenterPx[k], ib.CenterPx[k]) &&
+           nearly_equal(ia.k[k], ib.k[k]);
+  const vcg::Matrix44f ra = rotation(a), rb = rotation(b);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) same = same && nearly_equal(ra[r][c], rb[r][c]);
+  for (int k = 0; k < 3; ++k) same = same && nearly_equal(a.Extrinsics.Tra()[k], b.Extrinsics.Tra()[k]);
+  return same;
+}
 
 bool shot_is_valid(const Shot &shot) {
   const auto &in = shot.Intrinsics;

@@ -26,6 +26,11 @@ struct Raster {
 // True when the shot can project: positive focal length, pixel size and viewport, finite values.
 bool shot_is_valid(const Shot &shot);
 
+// True when two shots are one registration (photos of one viewpoint): equal viewport, and focal
+// length, pixel size, principal point, radial distortion, rotation and translation equal to 1e-6
+// relative (absolute below magnitude 1). Symmetric; false when any value is NaN.
+bool same_shot(const Shot &a, const Shot &b);
+
 struct ImagePoint {
   float x = 0, y = 0;      // image pixels (top-left origin, y down)
   bool in_front = false;   // point is in front of the camera (positive depth)

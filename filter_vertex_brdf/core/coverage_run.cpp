@@ -47,26 +47,6 @@ std::string strip_extension(const std::string &path) {
   return (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? path : path.substr(0, dot);
 }
 
-bool nearly(float a, float b) {
-  return std::fabs(a - b) <= 1e-6f * std::max(1.0f, std::max(std::fabs(a), std::fabs(b)));
-}
-
-bool same_shot(const Shot &a, const Shot &b) {
-  const auto &ia = a.Intrinsics, &ib = b.Intrinsics;
-  if (ia.ViewportPx != ib.ViewportPx) return false;
-  const float fa[] = {ia.FocalMm, ia.PixelSizeMm[0], ia.PixelSizeMm[1], ia.CenterPx[0], ia.CenterPx[1], ia.k[0], ia.k[1]};
-  const float fb[] = {ib.FocalMm, ib.PixelSizeMm[0], ib.PixelSizeMm[1], ib.CenterPx[0], ib.CenterPx[1], ib.k[0], ib.k[1]};
-  for (size_t i = 0; i < sizeof(fa) / sizeof(fa[0]); ++i)
-    if (!nearly(fa[i], fb[i])) return false;
-  const vcg::Matrix44f ra = a.Extrinsics.Rot(), rb = b.Extrinsics.Rot();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      if (!nearly(ra[r][c], rb[r][c])) return false;
-  for (int k = 0; k < 3; ++k)
-    if (!nearly(a.Extrinsics.Tra()[k], b.Extrinsics.Tra()[k])) return false;
-  return true;
-}
-
 std::vector<std::string> lp_files_in(const std::string &dir) {
   std::vector<std::string> found;
   if (DIR *d = ::opendir(dir.c_str())) {

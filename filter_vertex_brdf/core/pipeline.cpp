@@ -46,22 +46,6 @@ int bit(uint16_t flag) {
   return i;
 }
 
-bool nearly_equal(double a, double b) {
-  return std::fabs(a - b) <= 1e-6 * std::max({1.0, std::fabs(a), std::fabs(b)});
-}
-
-bool same_shot(const Shot &a, const Shot &b) {
-  const auto &ia = a.Intrinsics, &ib = b.Intrinsics;
-  bool same = ia.ViewportPx == ib.ViewportPx && nearly_equal(ia.FocalMm, ib.FocalMm);
-  for (int k = 0; k < 2; ++k)
-    same = same && nearly_equal(ia.PixelSizeMm[k], ib.PixelSizeMm[k]) && nearly_equal(ia.CenterPx[k], ib.CenterPx[k]) &&
-           nearly_equal(ia.k[k], ib.k[k]);
-  const auto ra = a.Extrinsics.Rot(), rb = b.Extrinsics.Rot();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) same = same && nearly_equal(ra[r][c], rb[r][c]);
-  for (int k = 0; k < 3; ++k) same = same && nearly_equal(a.Extrinsics.Tra()[k], b.Extrinsics.Tra()[k]);
-  return same;
-}
 } // namespace
 
 std::string default_output_path(const std::string &project_path) {

@@ -542,8 +542,11 @@ void finish_stats(PixelComparison &c, double de_sum) {
 
 } // namespace
 
-PixelComparison compare_with_photo(const RelitImage &render, const cv::Mat &photo_linear, const cv::Mat &photo_clipped,
-                                   float focal_px) {
+namespace {
+// Compares the pixels `use` accepts; pixels of a triangle without a fit are predicted black.
+template <class Use>
+PixelComparison compare_pixels(const RelitImage &render, const cv::Mat &photo_linear, const cv::Mat &photo_clipped,
+                               const Use &use) {
   if (photo_linear.cols != render.width || photo_linear.rows != render.height || photo_linear.type() != CV_32FC3 ||
       photo_clipped.size() != photo_linear.size())
     throw InputError("Relighting: the photo is " + std::to_string(photo_linear.cols) + "x" +
@@ -560,9 +563,10 @@ PixelComparison compare_with_photo(const RelitImage &render, const cv::Mat &phot
     const uint8_t *clip = photo_clipped.ptr<uint8_t>(y);
     for (int x = 0; x < render.width; ++x) {
       const size_t i = size_t(y) * size_t(render.width) + size_t(x);
-      if (render.pixel_class[i] != kRelitLit || clip[x] || !interior_pixel(render, x, y, focal_px)) continue;
-      float predicted[3];
-      for (int k = 0; k < 3; ++k) predicted[k] = std::min(1.0f, std::max(0.0f, render.rgb[3 * i + size_t(k)]));
+      if (clip[x] || !use(x, y, i)) continue;
+      float predicted[3] = {0, 0, 0};
+      if (render.pixel_class[i] != kRelitNoFit)
+        for (int k = 0; k < 3; ++k) predicted[k] = std::min(1.0f, std::max(0.0f, render.rgb[3 * i + size_t(k)]));
       const double de = delta_e2000_linear_srgb(predicted, photo + 3 * x);
       c.de2000[i] = float(de);
       de_sum += de;
@@ -576,6 +580,21 @@ PixelComparison compare_with_photo(const RelitImage &render, const cv::Mat &phot
   }
   finish_stats(c, de_sum);
   return c;
+}
+} // namespace
+
+PixelComparison compare_with_photo(const RelitImage &render, const cv::Mat &photo_linear, const cv::Mat &photo_clipped,
+                                   float focal_px) {
+  return compare_pixels(render, photo_linear, photo_clipped, [&](int x, int y, size_t i) {
+    return render.pixel_class[i] == kRelitLit && interior_pixel(render, x, y, focal_px);
+  });
+}
+
+PixelComparison compare_whole_surface(const RelitImage &render, const cv::Mat &photo_linear,
+                                      const cv::Mat &photo_clipped) {
+  return compare_pixels(render, photo_linear, photo_clipped, [&](int, int, size_t i) {
+    return render.pixel_class[i] == kRelitLit || render.pixel_class[i] == kRelitNoFit;
+  });
 }
 
 PixelComparison pool_comparisons(const std::vector<const PixelComparison *> &parts) {
@@ -850,7 +869,7 @@ ColorPlan plan_colors(const std::vector<Raster> &rasters, const std::vector<std:
 
 PixelComparison relight_one(RelightRenderer &renderer, const Raster &raster, const float light[3],
                             const RelightOutputOptions &options, const ColorCalibration *color, size_t color_photo,
-                            RasterImages *images) {
+                            RasterImages *images, PixelComparison *whole_surface) {
   if (!shot_is_valid(raster.shot))
     throw InputError("Raster '" + raster.label + "' has no valid camera: check its <VCGCamera> in the project.");
   cv::Mat linear, clipped;
@@ -862,6 +881,11 @@ PixelComparison relight_one(RelightRenderer &renderer, const Raster &raster, con
   const RelitImage render = renderer.render(raster.shot, light);
   const float focal_px = raster.shot.Intrinsics.FocalMm / raster.shot.Intrinsics.PixelSizeMm[0];
   PixelComparison c = compare_with_photo(render, linear, clipped, focal_px);
+  if (whole_surface) {
+    *whole_surface = compare_whole_surface(render, linear, clipped);
+    whole_surface->de2000.clear();
+    whole_surface->de2000.shrink_to_fit();
+  }
   if (images) {
     images->render = display_image(render);
     images->photo = display_image(linear);
@@ -881,11 +905,15 @@ std::string title_of(const RelightRow &row) {
 
 std::string relight_table_csv(const std::vector<RelightRow> &rows) {
   std::ostringstream out;
-  out << "raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db\n";
+  out << "raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db,"
+         "whole_surface_pixels,whole_surface_mean_de2000,whole_surface_median_de2000,whole_surface_p95_de2000,"
+         "whole_surface_psnr_db\n";
   for (const RelightRow &r : rows) {
-    const PixelComparison &c = r.comparison;
+    const PixelComparison &c = r.comparison, &w = r.whole_surface;
     out << csv_field(r.label) << ',' << csv_field(r.photo) << ',' << c.pixels << ',' << fixed(c.mean_de2000, 4) << ','
-        << fixed(c.median_de2000, 4) << ',' << fixed(c.p95_de2000, 4) << ',' << fixed(c.psnr_db, 3) << '\n';
+        << fixed(c.median_de2000, 4) << ',' << fixed(c.p95_de2000, 4) << ',' << fixed(c.psnr_db, 3) << ','
+        << w.pixels << ',' << fixed(w.mean_de2000, 4) << ',' << fixed(w.median_de2000, 4) << ','
+        << fixed(w.p95_de2000, 4) << ',' << fixed(w.psnr_db, 3) << '\n';
   }
   return out.str();
 }
@@ -913,7 +941,7 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
     row.label = rasters[r].label;
     row.photo = rasters[r].image_path;
     row.comparison = relight_one(renderer, rasters[r], light_dirs_world[r].data(), options, colors.of_raster[r],
-                                 colors.photo_of[r], write ? &images : nullptr);
+                                 colors.photo_of[r], write ? &images : nullptr, &row.whole_surface);
     if (write) {
       panels.push_back(side_by_side(images.render, images.photo, images.heat, title_of(row), options.heat_map_max_de));
       write_png_atomically(paths[r], panels.back());
@@ -927,6 +955,9 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
   for (const RelightRow &row : report.rows) parts.push_back(&row.comparison);
   report.overall.label = "all";
   report.overall.comparison = pool_comparisons(parts);
+  std::vector<const PixelComparison *> whole_parts;
+  for (const RelightRow &row : report.rows) whole_parts.push_back(&row.whole_surface);
+  report.overall.whole_surface = pool_comparisons(whole_parts);
   if (write) {
     write_png_atomically(paths[rasters.size()],
                          contact_sheet(panels, options.sheet_columns, options.sheet_panel_width));
@@ -944,23 +975,6 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
 // Cameras and names
 
 namespace {
-
-// Identical registrations (to 1e-6 relative): photos of one viewpoint.
-bool same_shot(const Shot &a, const Shot &b) {
-  auto close = [](double x, double y) {
-    return std::fabs(x - y) <= 1e-6 * std::max(1.0, std::max(std::fabs(x), std::fabs(y)));
-  };
-  const vcg::Matrix44f ra = a.Extrinsics.Rot(), rb = b.Extrinsics.Rot();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (!close(ra[i][j], rb[i][j])) return false;
-  for (int k = 0; k < 3; ++k)
-    if (!close(a.Extrinsics.Tra()[k], b.Extrinsics.Tra()[k])) return false;
-  const auto &ia = a.Intrinsics, &ib = b.Intrinsics;
-  return close(ia.FocalMm, ib.FocalMm) && close(ia.CenterPx[0], ib.CenterPx[0]) &&
-         close(ia.CenterPx[1], ib.CenterPx[1]) && ia.ViewportPx == ib.ViewportPx &&
-         close(ia.PixelSizeMm[0], ib.PixelSizeMm[0]) && close(ia.PixelSizeMm[1], ib.PixelSizeMm[1]);
-}
 
 // Rodrigues rotation of v about the unit axis u by angle t (radians).
 vcg::Point3f rotate(const vcg::Point3f &v, const vcg::Point3f &u, float t) {

@@ -15,6 +15,8 @@
 // shadow), every vertex of the triangle fitted, all 8 neighbours on the same surface (no
 // silhouette or depth jump: those photo pixels mix surfaces) and no clipped photo channel.
 // The prediction is clipped at 1 (what a camera records) for CIEDE2000 and PSNR.
+// Beside it, labelled, the whole surface (the RTI protocol): every lit or unfitted surface pixel,
+// silhouettes and depth jumps included, unfitted surface predicted black; clipped pixels left out.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -103,6 +105,13 @@ void photo_to_linear(const Photo &photo, cv::Mat &linear_rgb, cv::Mat &clipped);
 PixelComparison compare_with_photo(const RelitImage &render, const cv::Mat &photo_linear, const cv::Mat &photo_clipped,
                                    float focal_px);
 
+// Whole-surface comparison (the RTI protocol), reported beside the one above: every rendered surface
+// pixel that is lit (kRelitLit) or belongs to a triangle without a fit (kRelitNoFit, predicted
+// black: what relighting the PLY shows), silhouettes and depth jumps included; only pixels with a
+// clipped photo channel are left out. Throws InputError when the sizes differ.
+PixelComparison compare_whole_surface(const RelitImage &render, const cv::Mat &photo_linear,
+                                      const cv::Mat &photo_clipped);
+
 // Pools several comparisons (pixel-weighted mean, percentiles from the merged histograms,
 // PSNR of the pooled squared error).
 PixelComparison pool_comparisons(const std::vector<const PixelComparison *> &parts);
@@ -129,9 +138,12 @@ void write_png_atomically(const std::string &path, const cv::Mat &image);
 struct RelightRow {
   std::string label;     // raster label ("all" for the pooled row)
   std::string photo;     // photo path ("" for the pooled row / a novel view)
-  PixelComparison comparison;
+  PixelComparison comparison;     // lit visible interior pixels (compare_with_photo)
+  PixelComparison whole_surface;  // whole surface (compare_whole_surface; no per-pixel map)
 };
-// CSV: raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db (one row per entry).
+// CSV: raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db (lit visible interior
+// pixels), then whole_surface_pixels, whole_surface_mean/median/p95_de2000, whole_surface_psnr_db
+// (one row per entry).
 std::string relight_table_csv(const std::vector<RelightRow> &rows);
 
 // The fit corrects its samples with a ColorChecker seen in the photos (color_chart.h, when

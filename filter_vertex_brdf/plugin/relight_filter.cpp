@@ -183,14 +183,24 @@ void log_report(const vbrdf::RelightReport &report, const std::function<void(con
   char line[512];
   for (const vbrdf::RelightRow &row : report.rows) {
     const vbrdf::PixelComparison &c = row.comparison;
-    std::snprintf(line, sizeof line, "  %s: %zu lit pixels, CIEDE2000 mean %.2f, p95 %.2f, PSNR %.1f dB",
-                  row.label.c_str(), c.pixels, c.mean_de2000, c.p95_de2000, c.psnr_db);
+    const vbrdf::PixelComparison &w = row.whole_surface;
+    std::snprintf(line, sizeof line,
+                  "  %s: %zu lit pixels, CIEDE2000 mean %.2f, p95 %.2f, PSNR %.1f dB; whole surface (%zu pixels, "
+                  "unfitted as black): mean %.2f, p95 %.2f",
+                  row.label.c_str(), c.pixels, c.mean_de2000, c.p95_de2000, c.psnr_db, w.pixels, w.mean_de2000,
+                  w.p95_de2000);
     log(line);
   }
   const vbrdf::PixelComparison &all = report.overall.comparison;
   std::snprintf(line, sizeof line,
                 "Vertex BRDF relight: %zu rasters, %zu lit visible pixels: CIEDE2000 mean %.2f, p95 %.2f, PSNR %.1f dB",
                 report.rows.size(), all.pixels, all.mean_de2000, all.p95_de2000, all.psnr_db);
+  log(line);
+  const vbrdf::PixelComparison &whole = report.overall.whole_surface;
+  std::snprintf(line, sizeof line,
+                "Vertex BRDF relight: whole surface (%zu pixels, silhouettes included, unfitted surface as black): "
+                "CIEDE2000 mean %.2f, p95 %.2f, PSNR %.1f dB",
+                whole.pixels, whole.mean_de2000, whole.p95_de2000, whole.psnr_db);
   log(line);
 }
 
@@ -230,7 +240,9 @@ QString RelightFilter::info() const {
          "<b>Every raster</b>: each raster's camera under its light (from the .lp). For each raster an image "
          "<i>model | photo | CIEDE2000 heat map</i> is written, plus a contact sheet of all of them and a table "
          "(relight_table.csv: mean, median and 95th-percentile CIEDE2000 and PSNR over the lit visible pixels: lit "
-         "in the render, not at a silhouette or depth jump, no clipped photo channel). Use 'Raster project' to "
+         "in the render, not at a silhouette or depth jump, no clipped photo channel; beside it the same over the whole "
+         "surface: every lit or unfitted surface pixel, silhouettes included, unfitted surface predicted black, no "
+         "clipped photo channel). Use 'Raster project' to "
          "score photos the fit did not use (held-out lights), which measures how well the model relights.<br><br>"
          "<b>Novel view</b>: the camera of one raster orbited around the mesh centre and moved closer or farther, "
          "lit from a direction you give in that camera's frame (x right, y up, z towards the viewer, as in .lp "

@@ -2,8 +2,10 @@
 //   vbrdf_fit project.mlp [--lp lights.lp] [--out result.ply] [--visibility auto|gl|cpu]
 //             [--ts 0.9] [--td 0.5] [--encoding auto|srgb|linear] [--shadow-map 2048]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
+//             [--photo-dir DIR] [--color-correction off|auto|required]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
+// --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
 // Exit status: 0 success, 2 bad input (message on stderr), 3 processing error.
 #include <cstdio>
 #include <cstring>
@@ -12,6 +14,7 @@
 #include <string>
 
 #include "errors.h"
+#include "file_util.h"
 #include "mesh_io.h"
 #include "osmesa_context.h"
 #include "pipeline.h"
@@ -23,7 +26,8 @@ namespace {
 int usage() {
   std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
                "                 [--encoding auto|srgb|linear] [--shadow-map N] [--fit auto|gpu|cpu|off]\n"
-               "                 [--iterations N] [--alpha0 X] [--min-specular N]\n";
+               "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
+               "                 [--color-correction off|auto|required] [--no-remedies]\n";
   return 2;
 }
 } // namespace
@@ -31,7 +35,7 @@ int usage() {
 int main(int argc, char **argv) {
   if (argc < 2) return usage();
   FitSettings settings;
-  std::string mlp;
+  std::string mlp, photo_dir;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -43,6 +47,14 @@ int main(int argc, char **argv) {
     else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
     else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
+    else if (a == "--photo-dir") photo_dir = next();
+    else if (a == "--color-correction") {
+      const std::string v = next();
+      if (v == "off") settings.color_correction = ColorCorrectionChoice::Off;
+      else if (v == "auto") settings.color_correction = ColorCorrectionChoice::Auto;
+      else if (v == "required") settings.color_correction = ColorCorrectionChoice::Required;
+      else return usage();
+    }
     else if (a == "--no-remedies") {
       settings.phong.specular_weight_cap = 1e30f;
       settings.phong.diffuse_prior = 0;
@@ -73,6 +85,8 @@ int main(int argc, char **argv) {
     input.mesh_path = project.mesh_path;
     input.mesh_colors = mesh.colors;
     input.rasters = project.rasters;
+    if (!photo_dir.empty())
+      for (Raster &r : input.rasters) r.image_path = join_path(photo_dir, file_name_of(r.image_path));
     input.project_path = project.project_path;
     validate_input(input);
 

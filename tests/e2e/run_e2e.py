@@ -115,10 +115,14 @@ def cmd_fit(a):
         cmd = [a.eval_tool, "--result", out_ply, "--project", a.heldout]
         if a.heldout_photo_dir:
             cmd += ["--photo-dir", a.heldout_photo_dir]
+        # Bounds on vbrdf_eval's "clean pixels, modelled vertices only" figure (the measure these
+        # bounds were set for). Its headline figure is now the whole visible surface (mixed pixels,
+        # vertices without a model predicted black): switch to --max-mean-de / --max-p95-de once
+        # every seen vertex gets a model (issue 9, items 1-2).
         if a.max_relit_mean is not None:
-            cmd += ["--max-mean-de", str(a.max_relit_mean)]
+            cmd += ["--max-clean-mean-de", str(a.max_relit_mean)]
         if a.max_relit_p95 is not None:
-            cmd += ["--max-p95-de", str(a.max_relit_p95)]
+            cmd += ["--max-clean-p95-de", str(a.max_relit_p95)]
         print("running:", " ".join(cmd))
         ev = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         print(ev.stdout)

@@ -3,6 +3,7 @@
 // novel-view camera. GL through OSMesa; skipped when no context can be created.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -209,6 +210,40 @@ TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
   EXPECT_LT(bad.rows[0].comparison.psnr_db, 25.0);
 }
 
+// Whole surface (no GL needed): every lit or unfitted surface pixel, silhouettes included,
+// unfitted predicted black, clipped photo pixels left out; the interior measure drops the rim.
+TEST(RelightRender, WholeSurfaceComparisonCountsRimAndUnfittedPixels) {
+  const int w = 12, h = 10;
+  RelitImage r;
+  r.width = w;
+  r.height = h;
+  r.rgb.assign(size_t(3 * w * h), 0.4f);
+  r.pixel_class.assign(size_t(w * h), kRelitBackground);
+  r.depth.assign(size_t(w * h), 0.0f);
+  for (int y = 1; y < h - 1; ++y)
+    for (int x = 1; x < w - 1; ++x) {
+      const size_t i = size_t(y * w + x);
+      r.pixel_class[i] = x >= 8 ? kRelitNoFit : (y == 5 && x == 3) ? kRelitShadowed : kRelitLit;
+      r.depth[i] = 2.0f;
+    }
+  cv::Mat photo(h, w, CV_32FC3, cv::Scalar(0.4f, 0.4f, 0.4f));
+  cv::Mat clipped(h, w, CV_8U, cv::Scalar(0));
+  clipped.at<uint8_t>(2, 2) = 255;
+  const size_t surface = size_t((w - 2) * (h - 2));
+  const size_t nofit = size_t(3 * (h - 2));  // columns 8, 9, 10
+  const PixelComparison whole = compare_whole_surface(r, photo, clipped);
+  EXPECT_EQ(whole.pixels, surface - 1 /* shadowed */ - 1 /* clipped */);
+  const float black[3] = {0, 0, 0}, grey[3] = {0.4f, 0.4f, 0.4f};
+  const double de_black = delta_e2000_linear_srgb(black, grey);
+  EXPECT_NEAR(whole.mean_de2000, de_black * double(nofit) / double(whole.pixels), 1e-3);
+  EXPECT_GT(whole.p95_de2000, de_black - 0.02);  // 24 of 78 pixels are black
+  const PixelComparison interior = compare_with_photo(r, photo, clipped, 100.0f);
+  EXPECT_GT(interior.pixels, 0u);
+  EXPECT_LT(interior.pixels, whole.pixels - nofit);  // the rim next to the background is left out
+  EXPECT_LT(interior.mean_de2000, 1e-3);
+  EXPECT_THROW(compare_whole_surface(r, cv::Mat(h, w + 1, CV_32FC3), clipped), InputError);
+}
+
 TEST(RelightRender, WritesImagesContactSheetAndTable) {
   REQUIRE_GL(ctx);
   const float rho[3] = {0.6f, 0.4f, 0.2f}, model[3] = {0.5f, 0.4f, 0.25f};
@@ -233,11 +268,17 @@ TEST(RelightRender, WritesImagesContactSheetAndTable) {
   std::getline(csv, row1);
   std::getline(csv, row2);
   std::getline(csv, all);
-  EXPECT_EQ(header, "raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db");
+  EXPECT_EQ(header, "raster,photo,pixels,mean_de2000,median_de2000,p95_de2000,psnr_db,whole_surface_pixels,"
+                    "whole_surface_mean_de2000,whole_surface_median_de2000,whole_surface_p95_de2000,"
+                    "whole_surface_psnr_db");
   EXPECT_EQ(row1.rfind("\"held out, 1\",", 0), 0u) << row1;  // labels with commas are quoted
   EXPECT_EQ(all.rfind("all,,", 0), 0u) << all;
   EXPECT_NEAR(report.overall.comparison.mean_de2000, report.rows[0].comparison.mean_de2000, 1e-9);
   EXPECT_EQ(report.overall.comparison.pixels, 2 * report.rows[0].comparison.pixels);
+  // The whole-surface figure stands beside it: more pixels (the rim), pooled the same way.
+  EXPECT_GT(report.rows[0].whole_surface.pixels, report.rows[0].comparison.pixels);
+  EXPECT_EQ(report.overall.whole_surface.pixels, 2 * report.rows[0].whole_surface.pixels);
+  EXPECT_EQ(std::count(all.begin(), all.end(), ','), 11) << all;
 
   // Never over a photo; a missing photo is named with its raster.
   RelightOutputOptions over = options;
