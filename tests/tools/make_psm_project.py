@@ -3,7 +3,8 @@
 (Seitz, UW CSE 455 "psmImages": 12 photos, 512x340 uncompressed TGA, a mask, chrome-sphere
 light directions in lights.txt), so that the plugin can fit it and vbrdf_eval can score it.
 
-    make_psm_project.py DATA_DIR OBJECT OUT_DIR [--heldout I J K] [--camera-distance D]
+    make_psm_project.py DATA_DIR OBJECT OUT_DIR [--heldout I J K] [--photos linear|srgb]
+                        [--camera-distance D]
 
 DATA_DIR holds lights.txt and OBJECT/OBJECT.{0..11}.tga + OBJECT.mask.tga (e.g.
 ../shared/real/psm_uw_seitz). Written to OUT_DIR:
@@ -12,13 +13,22 @@ DATA_DIR holds lights.txt and OBJECT/OBJECT.{0..11}.tga + OBJECT.mask.tga (e.g.
     project.mlp       the mesh + one raster per training photo, all with the same camera
     lights.lp         count, then `images/light_KK.png lx ly lz` (camera frame: x right, y up,
                       z towards the viewer; unit directions towards the light)
-    images/           the training photos as 8-bit RGB PNG, pixel values as given
+    images/           the training photos as RGB PNG (16-bit linear or 8-bit as given: --photos)
     heldout/          project.mlp (mesh ../mesh.ply), lights.lp, images/ for the held-out lights
     psm_project.json  what was done (light indices, sample counts, depth range, registration)
 
 Method (python3 + numpy only):
-  * Photos are taken as sRGB-encoded (the plugin's default decoding for 8-bit photos) and
-    linearised; grey = mean of the linear RGB.
+  * Photo encoding (--photos). `linear` (default): the 8-bit values are proportional to
+    radiance; the photos are written as 16-bit PNG (value * 257, exact), which the plugin's
+    default (photo encoding Auto) reads as linear. `srgb`: the 8-bit values are taken as
+    sRGB-encoded and written as 8-bit PNG as given (Auto decodes 8-bit as sRGB). Either way the
+    photometric stereo uses the same linear values the plugin will see; grey = mean of RGB.
+    Why linear by default: on the set's matte grey sphere (gray/, normals known from the mask's
+    circle) the 8-bit grey follows (N.L)^0.92 as given but (N.L)^1.93 after sRGB decoding
+    (grey_sphere_exponent() below), and the course's reference buddha normals
+    (extras_reference_outputs) agree with normals from the values as given (median 1.8 deg)
+    but not from sRGB-decoded ones (16.5 deg). Decoding as sRGB tilts every normal away from
+    the camera, so about half of all vertex-photo pairs fall under T_d = 0.5 on N.L.
   * Normals: per-pixel least squares I = L g (g = albedo * n) on the training lights only. A
     sample is dropped when it is saturated (any channel >= 250 of 255) or dark (grey below
     DARK_FRACTION of the pixel's brightest unsaturated training sample, or below DARK_ABS),
@@ -361,7 +371,32 @@ def check_registration(mlp_path, vertices, pixel_cols, pixel_rows, height):
 
 
 # ----------------------------------------------------------------------------- main
-def build(data_dir, name, out_dir, heldout=None, distance=1e5, photos_as='srgb', log=print):
+def grey_sphere_exponent(data_dir, photos_as='linear', min_ndl=0.2):
+    """Exponent g of grey ~ (N.L)^g on the set's matte grey sphere (gray/gray.K.tga, normals from
+    the mask's centroid and area-equivalent radius, inner 90 % of the radius, unsaturated samples
+    with N.L > min_ndl), with the photos decoded as `photos_as`. About 1 when the decoding is
+    right for a Lambertian sphere."""
+    lights = read_lights(os.path.join(data_dir, 'lights.txt'))
+    mask = read_tga(os.path.join(data_dir, 'gray', 'gray.mask.tga')).max(axis=2) > 127
+    rows, cols = np.nonzero(mask)
+    cy, cx, radius = rows.mean(), cols.mean(), np.sqrt(mask.sum() / np.pi)
+    nx, ny = (cols - cx) / radius, -(rows - cy) / radius
+    inner = nx ** 2 + ny ** 2 < 0.81
+    normals = np.stack([nx, ny, np.sqrt(np.clip(1 - nx ** 2 - ny ** 2, 0, 1))], 1)[inner]
+    x, y = [], []
+    for k in range(len(lights)):
+        pix = read_tga(os.path.join(data_dir, 'gray', 'gray.%d.tga' % k))[rows[inner], cols[inner]]
+        grey = (srgb_to_linear(pix) if photos_as == 'srgb' else pix / 255.0).mean(axis=1)
+        ndl = normals @ lights[k]
+        ok = (ndl > min_ndl) & (pix.max(axis=1) < SATURATED) & (grey > 0)
+        x.append(np.log(ndl[ok]))
+        y.append(np.log(grey[ok]))
+    x, y = np.concatenate(x), np.concatenate(y)
+    design = np.stack([np.ones_like(x), x], 1)
+    return float(np.linalg.lstsq(design, y, rcond=None)[0][1])
+
+
+def build(data_dir, name, out_dir, heldout=None, distance=1e5, photos_as='linear', log=print):
     lights_all = read_lights(os.path.join(data_dir, 'lights.txt'))
     obj_dir = os.path.join(data_dir, name)
     if not os.path.isdir(obj_dir):
@@ -456,7 +491,7 @@ def main(argv=None):
     ap.add_argument('out_dir')
     ap.add_argument('--heldout', type=int, nargs='+', default=None,
                     help='held-out light indices (default: 3 interior lights, farthest-point order)')
-    ap.add_argument('--photos', choices=('srgb', 'linear'), default='srgb',
+    ap.add_argument('--photos', choices=('srgb', 'linear'), default='linear',
                     help='how the 8-bit photos are encoded (module docstring)')
     ap.add_argument('--camera-distance', type=float, default=1e5, help='camera distance in px')
     args = ap.parse_args(argv)
