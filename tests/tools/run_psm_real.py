@@ -13,11 +13,15 @@ Checks (each can fail):
     with the camera of project.mlp (MeshLab's formula), lands within 0.01 px of a pixel centre,
     on a mask pixel, one vertex per mask pixel;
   * the fit runs (exit 0), its PLY has one row per mesh vertex and no NaN/inf in any property;
+  * registration as the plugin samples it: over fitted vertices, the fit's diffuse colour
+    (r+g+b) correlates better with the photometric-stereo albedo at the vertex's own pixel than
+    at any 1-px shift (an image flip or half-pixel convention error breaks this);
   * vbrdf_eval runs on heldout/project.mlp, scores samples and prints finite figures.
 Printed for the record: share of vertices per fit_status, relit CIEDE2000 mean / p95.
 Exit status 77 (ctest SKIP_RETURN_CODE) when the data folder is absent, 1 on a failed check.
 """
 import argparse
+import json
 import os
 import re
 import shutil
@@ -84,6 +88,33 @@ def check_registration(out_dir, mask):
     return failures
 
 
+def sampling_check(args, name, fit, mask):
+    """Correlation of the fit's diffuse colour with the photometric-stereo albedo at the vertex's
+    pixel and at the four 1-px shifts; returns a list of failures."""
+    rows, cols = np.nonzero(mask)   # the builder's vertex order
+    lights = psm.read_lights(os.path.join(args.data, 'lights.txt'))
+    with open(os.path.join(args.workdir, name, 'psm_project.json')) as f:
+        train = json.load(f)['train_lights']
+    photos = np.stack([psm.read_tga(os.path.join(args.data, name, '%s.%d.tga' % (name, k))) for k in train])
+    fitted = fit['fit_status'] > 0
+    diffuse = (fit['diffuse_r'] + fit['diffuse_g'] + fit['diffuse_b'])[fitted]
+    corr = {}
+    for dr, dc in [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)]:
+        rr = np.clip(rows + dr, 0, mask.shape[0] - 1)
+        cc = np.clip(cols + dc, 0, mask.shape[1] - 1)
+        stack = photos[:, rr, cc]
+        lin = psm.srgb_to_linear(stack) if args.photos == 'srgb' else stack / 255.0
+        _, albedo, _ = psm.photometric_normals(lin.mean(axis=2), stack.max(axis=2) >= psm.SATURATED, lights[train])
+        corr[(dr, dc)] = float(np.corrcoef(diffuse, albedo[fitted])[0, 1])
+    print('  diffuse colour vs PS albedo, correlation at shifts (row, col): '
+          + ', '.join('%s %.4f' % (k, v) for k, v in corr.items()))
+    best_shift = max((v, k) for k, v in corr.items() if k != (0, 0))
+    if not corr[(0, 0)] > best_shift[0]:
+        return ['%s: the fit samples the photos off the vertex pixels (shift %s correlates better)'
+                % (name, best_shift[1])]
+    return []
+
+
 def run(cmd):
     print('  $ ' + ' '.join(cmd))
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
@@ -120,6 +151,8 @@ def check_object(args, name):
         status = fit['fit_status']
         shares = ', '.join('%d: %.1f %%' % (s, 100.0 * np.mean(status == s)) for s in np.unique(status))
         print('  fit_status shares (of %d vertices): %s' % (len(status), shares))
+        if not failures:
+            failures += sampling_check(args, name, fit, mask)
 
     rc, text = run([args.eval_tool, '--result', fit_ply, '--project', os.path.join(out, 'heldout', 'project.mlp')])
     print('\n'.join('   ' + l for l in text.splitlines()))
