@@ -1,0 +1,198 @@
+#!/usr/bin/python3
+"""ctest driver (psm_real_projects): builds registered projects from the real photometric-stereo
+set (make_psm_project.py) into a work folder, fits them with vbrdf_fit (defaults) and scores
+them with vbrdf_eval on the held-out lights.
+
+    run_psm_real.py --data DIR --workdir DIR --fit-tool vbrdf_fit --eval-tool vbrdf_eval
+                    [--objects owl cat] [--photos linear|srgb]
+
+Checks (each can fail):
+  * the set's decoding: on the matte grey sphere, grey ~ (N.L)^g with |g - 1| < 0.25 for the
+    chosen --photos decoding (a wrong decoding gives g of about 2);
+  * registration, independently of the builder's own check: every vertex of mesh.ply, projected
+    with the camera of project.mlp (MeshLab's formula), lands within 0.01 px of a pixel centre,
+    on a mask pixel, one vertex per mask pixel;
+  * the fit runs (exit 0), its PLY has one row per mesh vertex and no NaN/inf in any property;
+  * registration as the plugin samples it: over fitted vertices, the fit's diffuse colour
+    (r+g+b) correlates better with the photometric-stereo albedo at the vertex's own pixel than
+    at any 1-px shift (an image flip or half-pixel convention error breaks this);
+  * vbrdf_eval runs on heldout/project.mlp, scores samples and prints finite figures.
+Printed for the record: share of vertices per fit_status, relit CIEDE2000 mean / p95.
+Exit status 77 (ctest SKIP_RETURN_CODE) when the data folder is absent, 1 on a failed check.
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import make_psm_project as psm  # noqa: E402
+
+SKIP = 77
+PLY_TYPES = {'float': '<f4', 'float32': '<f4', 'double': '<f8', 'uchar': 'u1', 'uint8': 'u1',
+             'int': '<i4', 'int32': '<i4', 'uint': '<u4', 'short': '<i2', 'ushort': '<u2'}
+
+
+def read_ply_vertices(path):
+    """Vertex table of a binary little-endian PLY (vertex element first) as a structured array."""
+    with open(path, 'rb') as f:
+        data = f.read()
+    end = data.index(b'end_header\n') + len(b'end_header\n')
+    header = data[:end].decode('ascii').splitlines()
+    if 'format binary_little_endian 1.0' not in header:
+        raise ValueError('%s: not binary little-endian' % path)
+    count, props, in_vertex = 0, [], False
+    for line in header:
+        t = line.split()
+        if t and t[0] == 'element':
+            in_vertex = t[1] == 'vertex'
+            if in_vertex:
+                count = int(t[2])
+        elif t and t[0] == 'property' and in_vertex:
+            if t[1] == 'list':
+                raise ValueError('%s: list property in vertex element' % path)
+            props.append((t[2], PLY_TYPES[t[1]]))
+    return np.frombuffer(data, np.dtype(props), count, end)
+
+
+def check_registration(out_dir, mask):
+    """Independent re-projection of mesh.ply through project.mlp; returns a list of failures."""
+    vert = read_ply_vertices(os.path.join(out_dir, 'mesh.ply'))
+    cam = psm.parse_camera(os.path.join(out_dir, 'project.mlp'))
+    rot = cam['RotationMatrix'].reshape(4, 4)[:3, :3]
+    pos = np.stack([vert['x'], vert['y'], vert['z']], 1).astype(np.float64)
+    cp = (pos + cam['TranslationVector'][:3]) @ rot.T
+    cp[:, 2] = -cp[:, 2]
+    px = cam['FocalMm'][0] * cp[:, :2] / cp[:, 2:3] / cam['PixelSizeMm'] + cam['CenterPx']
+    height = int(cam['ViewportPx'][1])
+    col, row = px[:, 0] - 0.5, height - px[:, 1] - 0.5   # top-down row of the pixel centre
+    ci, ri = np.round(col).astype(int), np.round(row).astype(int)
+    err = np.maximum(np.abs(col - ci), np.abs(row - ri))
+    failures = []
+    if not np.all(cp[:, 2] > 0):
+        failures.append('vertices behind the camera')
+    if err.max() > psm.REGISTRATION_TOL_PX:
+        failures.append('a vertex projects %.3g px from a pixel centre' % err.max())
+    inside = (ci >= 0) & (ci < mask.shape[1]) & (ri >= 0) & (ri < mask.shape[0])
+    if not inside.all() or not mask[ri[inside], ci[inside]].all():
+        failures.append('vertices outside the mask')
+    if len(set(zip(ri.tolist(), ci.tolist()))) != len(vert) or len(vert) != int(mask.sum()):
+        failures.append('not one vertex per mask pixel (%d vertices, %d mask pixels)'
+                        % (len(vert), int(mask.sum())))
+    print('  registration: %d vertices, max %.2e px from their pixel centres' % (len(vert), err.max()))
+    return failures
+
+
+def sampling_check(args, name, fit, mask):
+    """Correlation of the fit's diffuse colour with the photometric-stereo albedo at the vertex's
+    pixel and at the four 1-px shifts; returns a list of failures."""
+    rows, cols = np.nonzero(mask)   # the builder's vertex order
+    lights = psm.read_lights(os.path.join(args.data, 'lights.txt'))
+    with open(os.path.join(args.workdir, name, 'psm_project.json')) as f:
+        train = json.load(f)['train_lights']
+    photos = np.stack([psm.read_tga(os.path.join(args.data, name, '%s.%d.tga' % (name, k))) for k in train])
+    fitted = fit['fit_status'] > 0
+    diffuse = (fit['diffuse_r'] + fit['diffuse_g'] + fit['diffuse_b'])[fitted]
+    corr = {}
+    for dr, dc in [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)]:
+        rr = np.clip(rows + dr, 0, mask.shape[0] - 1)
+        cc = np.clip(cols + dc, 0, mask.shape[1] - 1)
+        stack = photos[:, rr, cc]
+        lin = psm.srgb_to_linear(stack) if args.photos == 'srgb' else stack / 255.0
+        _, albedo, _ = psm.photometric_normals(lin.mean(axis=2), stack.max(axis=2) >= psm.SATURATED, lights[train])
+        corr[(dr, dc)] = float(np.corrcoef(diffuse, albedo[fitted])[0, 1])
+    print('  diffuse colour vs PS albedo, correlation at shifts (row, col): '
+          + ', '.join('%s %.4f' % (k, v) for k, v in corr.items()))
+    best_shift = max((v, k) for k, v in corr.items() if k != (0, 0))
+    if not corr[(0, 0)] > best_shift[0]:
+        return ['%s: the fit samples the photos off the vertex pixels (shift %s correlates better)'
+                % (name, best_shift[1])]
+    return []
+
+
+def run(cmd):
+    print('  $ ' + ' '.join(cmd))
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    return p.returncode, p.stdout
+
+
+def check_object(args, name):
+    failures = []
+    out = os.path.join(args.workdir, name)
+    shutil.rmtree(out, ignore_errors=True)
+    try:
+        psm.build(args.data, name, out, photos_as=args.photos, log=lambda s: print('  ' + s))
+    except psm.RegistrationError as e:
+        return ['%s: builder: %s' % (name, e)]
+    mask = psm.read_tga(os.path.join(args.data, name, '%s.mask.tga' % name)).max(axis=2) > 127
+    failures += ['%s: %s' % (name, f) for f in check_registration(out, mask)]
+
+    fit_ply = os.path.join(out, 'fit.ply')
+    rc, text = run([args.fit_tool, os.path.join(out, 'project.mlp'), '--out', fit_ply])
+    if rc != 0 or not os.path.exists(fit_ply):
+        print(text)
+        return failures + ['%s: vbrdf_fit exited %d' % (name, rc)]
+    for line in text.splitlines():
+        if re.search(r'grazing light|no usable sample \(|full fits|vertices coloured', line):
+            print('   ' + line.strip())
+    fit = read_ply_vertices(fit_ply)
+    n_mesh = len(read_ply_vertices(os.path.join(out, 'mesh.ply')))
+    if len(fit) != n_mesh:
+        failures.append('%s: fit has %d vertices, mesh %d' % (name, len(fit), n_mesh))
+    bad = [p for p in fit.dtype.names if fit.dtype[p].kind == 'f' and not np.all(np.isfinite(fit[p]))]
+    if bad:
+        failures.append('%s: NaN/inf in %s' % (name, ', '.join(bad)))
+    if 'fit_status' in fit.dtype.names:
+        status = fit['fit_status']
+        shares = ', '.join('%d: %.1f %%' % (s, 100.0 * np.mean(status == s)) for s in np.unique(status))
+        print('  fit_status shares (of %d vertices): %s' % (len(status), shares))
+        if not failures:
+            failures += sampling_check(args, name, fit, mask)
+
+    rc, text = run([args.eval_tool, '--result', fit_ply, '--project', os.path.join(out, 'heldout', 'project.mlp')])
+    print('\n'.join('   ' + l for l in text.splitlines()))
+    m = re.search(r'(\d+) samples, CIEDE2000 mean ([-\d.naif]+), median [-\d.naif]+, p95 ([-\d.naif]+)', text)
+    if rc != 0 or not m:
+        failures.append('%s: vbrdf_eval exited %d' % (name, rc))
+    elif not (int(m.group(1)) > 0 and np.isfinite(float(m.group(2))) and np.isfinite(float(m.group(3)))):
+        failures.append('%s: vbrdf_eval figures not finite or no samples' % name)
+    else:
+        print('  RESULT %s: relit CIEDE2000 mean %s, p95 %s (%s samples)' % (name, m.group(2), m.group(3), m.group(1)))
+    return failures
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--data', required=True)
+    ap.add_argument('--workdir', required=True)
+    ap.add_argument('--fit-tool', required=True)
+    ap.add_argument('--eval-tool', required=True)
+    ap.add_argument('--objects', nargs='+', default=['owl', 'cat'])
+    ap.add_argument('--photos', choices=('linear', 'srgb'), default='linear')
+    args = ap.parse_args()
+    if not os.path.isfile(os.path.join(args.data, 'lights.txt')):
+        print('SKIP: real photometric-stereo set not found at %s (see the README: it lives in '
+              '../shared beside the repository and is not part of it)' % args.data)
+        return SKIP
+    failures = []
+    exponent = psm.grey_sphere_exponent(args.data, args.photos)
+    print('grey sphere: grey ~ (N.L)^%.3f with the photos decoded as %s' % (exponent, args.photos))
+    if abs(exponent - 1.0) >= 0.25:
+        failures.append('grey sphere exponent %.3f: decoding %s is not linear in radiance' % (exponent, args.photos))
+    os.makedirs(args.workdir, exist_ok=True)
+    for name in args.objects:
+        print('== %s' % name)
+        failures += check_object(args, name)
+    for f in failures:
+        print('FAIL: ' + f)
+    print('OK' if not failures else '%d check(s) failed' % len(failures))
+    return 1 if failures else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
