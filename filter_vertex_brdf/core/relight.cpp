@@ -119,6 +119,32 @@ struct Scored {
   bool mixed, modelled, has_baseline;
 };
 
+// The prediction of the photo's bilinear sample at image point (x, y) whose footprint pixels
+// `own` (visibility.h's mask, from the camera pass) show the vertex's own surface
+// (RelightOptions::rendered): those take the vertex's model, the others the mean of the render's
+// subpixels there (background, another surface), as the sensor integrates them.
+void predict_footprint(const FineRender &render, float x, float y, uint8_t own, const float vertex_rgb[3],
+                       float out[3]) {
+  const float fx = x - 0.5f, fy = y - 0.5f;
+  const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy)), s = render.scale;
+  const int width = render.rgb.cols / s, height = render.rgb.rows / s;
+  const float ax = fx - float(x0), ay = fy - float(y0);
+  const float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+  for (int c = 0; c < 3; ++c) out[c] = 0;
+  for (int k = 0; k < 4; ++k) {
+    float texel[3] = {vertex_rgb[0], vertex_rgb[1], vertex_rgb[2]};
+    if (!(own >> k & 1u)) {
+      const int xi = std::min(std::max(x0 + k % 2, 0), width - 1), yi = std::min(std::max(y0 + k / 2, 0), height - 1);
+      texel[0] = texel[1] = texel[2] = 0;
+      for (int sy = 0; sy < s; ++sy) {
+        const float *rgb = render.rgb.ptr<float>(yi * s + sy) + 3 * xi * s;
+        for (int i = 0; i < 3 * s; ++i) texel[i % 3] += rgb[i] / float(s * s);
+      }
+    }
+    for (int c = 0; c < 3; ++c) out[c] += w[k] * texel[c];
+  }
+}
+
 void clamp_below_zero(float rgb[3]) {
   for (int c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c], 0.0f);
 }
@@ -133,6 +159,20 @@ void check_sizes(const MeshView &mesh, const std::vector<VertexFit> &fits, const
   if (options.vertex_filter && options.vertex_filter->size() != mesh.vertex_count)
     throw InputError("Relighting evaluation: the vertex filter has " + std::to_string(options.vertex_filter->size()) +
                      " entries for a mesh of " + std::to_string(mesh.vertex_count) + " vertices.");
+  if (options.rendered && options.rendered->size() != rasters.size())
+    throw InputError("Relighting evaluation: one rendered image per held-out photo is needed.");
+  if (options.rendered)
+    for (size_t r = 0; r < rasters.size(); ++r)
+      if ((*options.rendered)[r].rgb.type() != CV_32FC3 || (*options.rendered)[r].depth.type() != CV_32F ||
+          (*options.rendered)[r].rgb.cols != rasters[r].width() * (*options.rendered)[r].scale ||
+          (*options.rendered)[r].rgb.rows != rasters[r].height() * (*options.rendered)[r].scale ||
+          (*options.rendered)[r].depth.size() != (*options.rendered)[r].rgb.size())
+        throw InputError("Relighting evaluation: the rendered image of '" + rasters[r].label +
+                         "' does not match the photo's size.");
+  if (options.lit_filter && options.lit_filter->size() != mesh.vertex_count * rasters.size())
+    throw InputError("Relighting evaluation: the lit filter has " + std::to_string(options.lit_filter->size()) +
+                     " entries; expected held-out photos x vertices = " +
+                     std::to_string(mesh.vertex_count * rasters.size()) + ".");
   if (bool(options.training_rasters) != bool(options.training_light_dirs_world) ||
       (options.training_rasters && options.training_rasters->size() != options.training_light_dirs_world->size()))
     throw InputError("Relighting evaluation: the baselines need one light direction per training photo.");
@@ -170,7 +210,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
   const VisibilityMasks masks = compute_visibility(mesh, all, all_lights, visibility);
   PhotoCache photos(settings.encoding, settings.saturation_level, settings.photo_cache_bytes);
 
-  std::vector<double> de_all, de_clean, de_base_product, de_ptm, de_rbf;
+  std::vector<double> de_all, de_clean, de_base_product, de_ptm, de_rbf, fp_product[2], fp_rbf[2];
   double squared_error = 0;
   std::vector<std::vector<Scored>> scored;
   gather_samples(mesh, all, all_lights, masks, settings, photos, [&](const SampleChunk &chunk) {
@@ -189,13 +229,22 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
       for (size_t k = 0; k < count; ++k) {
         const Sample &s = samples[k];
         if (s.raster >= n_held) continue;  // training photo
-        if ((s.flags & (kShadowed | kSaturated)) || !(s.n_dot_l > 0)) continue;
+        if (s.flags & kSaturated) continue;
+        if (options.lit_filter ? !(*options.lit_filter)[size_t(s.raster) * mesh.vertex_count + v]
+                               : ((s.flags & kShadowed) || !(s.n_dot_l > 0)))
+          continue;
         Scored r{};
         r.raster = s.raster;
         r.mixed = (s.flags & kMixedPixel) != 0;
         r.modelled = fit.status != kFitNone;
         float predicted[3];
         evaluate_phong(fit, s.n_dot_l, s.r_dot_e, predicted);
+        const uint8_t own = masks.own_texels(s.raster, v);
+        if (options.rendered && own != kAllFootprintTexels) {
+          const ImagePoint ip = project_to_image(rasters[s.raster].shot, mesh.positions + 3 * v);
+          const float at_vertex[3] = {predicted[0], predicted[1], predicted[2]};
+          predict_footprint((*options.rendered)[s.raster], ip.x, ip.y, own, at_vertex, predicted);
+        }
         r.de = float(delta_e2000_linear_srgb(predicted, s.rgb));
         for (int c = 0; c < 3; ++c) {
           const float e = std::min(predicted[c], 1.0f) - s.rgb[c];
@@ -241,6 +290,8 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         de_base_product.push_back(r.de);
         de_ptm.push_back(r.de_ptm);
         de_rbf.push_back(r.de_rbf);
+        fp_product[r.mixed].push_back(r.de);
+        fp_rbf[r.mixed].push_back(r.de_rbf);
       }
     }
   });
@@ -261,6 +312,10 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
   stats.product_on_baseline_set = summarise(de_base_product);
   stats.ptm = summarise(de_ptm);
   stats.rbf = summarise(de_rbf);
+  stats.product_clean_footprint = summarise(fp_product[0]);
+  stats.rbf_clean_footprint = summarise(fp_rbf[0]);
+  stats.product_mixed_footprint = summarise(fp_product[1]);
+  stats.rbf_mixed_footprint = summarise(fp_rbf[1]);
   return stats;
 }
 

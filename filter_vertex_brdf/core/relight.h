@@ -8,9 +8,11 @@
 #include <cstdint>
 #include <vector>
 
+
 #include "camera.h"
 #include "mesh_view.h"
 #include "phong_fit.h"
+#include "relight_render.h"
 #include "samples.h"
 
 namespace vbrdf {
@@ -30,6 +32,19 @@ struct RelightOptions {
   // Optional (null = all vertices): one entry per vertex; only vertices with a non-zero entry are
   // scored (e.g. the ground truth's `visible`). A size other than the vertex count is an InputError.
   const std::vector<uint8_t> *vertex_filter = nullptr;
+  // Optional (null = our shadow passes decide): per held-out raster and vertex (raster-major,
+  // rasters x vertices entries), non-zero where the vertex is lit (e.g. the ground truth's
+  // `heldout_lit`). Where given it replaces the shadow flags: lit samples are scored even where our
+  // shadow map disagrees, unlit ones never are.
+  const std::vector<uint8_t> *lit_filter = nullptr;
+  // Optional (null = the vertex's model alone): per held-out raster, the model rendered with
+  // subpixels for that camera (relight_render.h render_supersampled). The product then predicts a
+  // sample as the photo is sampled: bilinearly over the vertex's 2x2 pixel footprint, where the
+  // pixels on the vertex's own surface (the camera pass's footprint mask) take the vertex's model
+  // (evaluate_phong) and, at silhouettes and contacts, the others (background, another surface)
+  // the render's mean over their subpixels, as a sensor pixel integrates. Inside a surface this is
+  // exactly the vertex's model.
+  const std::vector<FineRender> *rendered = nullptr;
   // Optional baselines (both null = off): the training rasters and their world light directions.
   // For each held-out raster the training rasters of the same viewpoint (same_shot) are used; the
   // vertex's samples there (plain bilinear, shadowed kept, saturated dropped) fit PTM and RBF.
@@ -69,6 +84,9 @@ struct RelightStats {
   ErrorSummary product_on_baseline_set;
   ErrorSummary ptm;
   ErrorSummary rbf;
+  // The same three, split by the held-out sample's footprint: clean (on one surface) and mixed
+  // (straddling a silhouette or contact: the photo mixes surfaces, every method is scored on it).
+  ErrorSummary product_clean_footprint, rbf_clean_footprint, product_mixed_footprint, rbf_mixed_footprint;
   size_t baseline_excluded = 0;
   std::vector<float> rbf_sigma_per_raster;  // sigma used for each held-out raster (0: no training viewpoint)
 };

@@ -475,6 +475,27 @@ RelitImage RelightRenderer::render(const Shot &shot, const float light_dir_world
 
 const char *RelightRenderer::renderer_name() const { return impl_->renderer.c_str(); }
 
+FineRender render_supersampled(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
+                               int max_scale) {
+  const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
+  int s = std::max(1, max_scale);
+  // Memory (16 bytes per fine pixel) and GL limits (8192 per side everywhere).
+  while (s > 1 && (double(width) * height * s * s > double(1 << 23) || width * s > 8192 || height * s > 8192)) --s;
+  Shot fine = shot;  // the same camera with s x s smaller pixels (VCG pixels scale by s)
+  fine.Intrinsics.ViewportPx[0] = width * s;
+  fine.Intrinsics.ViewportPx[1] = height * s;
+  for (int k = 0; k < 2; ++k) {
+    fine.Intrinsics.PixelSizeMm[k] /= float(s);
+    fine.Intrinsics.CenterPx[k] *= float(s);
+  }
+  const RelitImage image = renderer.render(fine, light_dir_world);
+  FineRender out;
+  out.scale = s;
+  cv::Mat(image.height, image.width, CV_32FC3, const_cast<float *>(image.rgb.data())).copyTo(out.rgb);
+  cv::Mat(image.height, image.width, CV_32F, const_cast<float *>(image.depth.data())).copyTo(out.depth);
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Comparison
 

@@ -82,6 +82,18 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
+// The model rendered for the camera of `shot` with `scale` x `scale` subpixels per photo pixel
+// (pixel (x, y) of the photo covers fine pixels [x*scale, (x+1)*scale) x [y*scale, (y+1)*scale)),
+// so that what a sensor pixel integrates at silhouettes and contacts can be predicted. `scale` is
+// max_scale, reduced for large photos (at most 2^23 fine pixels) and to the GL size limits.
+struct FineRender {
+  int scale = 1;
+  cv::Mat rgb;    // CV_32FC3 linear RGB, row 0 = top; background and shadow 0
+  cv::Mat depth;  // CV_32F view depth of the surface, 0 on background
+};
+FineRender render_supersampled(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
+                               int max_scale = 4);
+
 // Per-pixel comparison of a render with a photo of the same camera.
 struct PixelComparison {
   int width = 0, height = 0;

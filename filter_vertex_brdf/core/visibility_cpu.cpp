@@ -154,12 +154,12 @@ bool CpuVisibility::blocked(MarkState &marks, const vcg::Point3f &from, const vc
 }
 
 float CpuVisibility::first_hit(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist) {
-  if (triangles_.empty() || !(max_dist > 0)) return std::numeric_limits<float>::infinity();
+  const float none = std::numeric_limits<float>::infinity();
+  if (triangles_.empty() || !(max_dist > 0)) return none;
   RayTriangleHit hit;
   StampMarker marker(&marks, triangles_.data());
   float t = 0;
-  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) ? t
-                                                                                 : std::numeric_limits<float>::infinity();
+  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) ? t : none;
 }
 
 uint8_t CpuVisibility::footprint_code(MarkState &marks, const Shot &shot, const vcg::Point3f &centre,
@@ -171,15 +171,23 @@ uint8_t CpuVisibility::footprint_code(MarkState &marks, const Shot &shot, const 
   for (int k = 0; k < 4; ++k) {
     const int i = x0 + k % 2, j = y0 + k / 2;
     if (i < 0 || j < 0 || i >= width || j >= height) continue;
-    // A point on the texel's pixel ray (VCG pixels: y up), at the vertex's depth.
-    const vcg::Point3f on_ray = shot.UnProject(vcg::Point2f(float(i) + 0.5f, float(height - j) - 0.5f), vertex_depth);
-    vcg::Point3f dir = on_ray - centre;
-    const float len = dir.Norm();
-    if (!(len > 0)) continue;
-    dir /= len;
-    // Depth along the view axis scales with distance along the ray by vertex_depth / len.
-    const float t = first_hit(marks, centre, dir, 2 * (len + diagonal_));
-    if (std::isfinite(t) && std::fabs(t * vertex_depth / len - vertex_depth) <= slack) mask |= footprint_texel_bit(k);
+    // The texel centre's pixel ray in the camera frame (x right, y up, z towards the viewer; VCG
+    // pixels have y up), scaled so that its view depth is 1.
+    const auto &in = shot.Intrinsics;
+    const float cam[3] = {(float(i) + 0.5f - in.CenterPx[0]) * in.PixelSizeMm[0] / in.FocalMm,
+                          (float(height - j) - 0.5f - in.CenterPx[1]) * in.PixelSizeMm[1] / in.FocalMm, -1.0f};
+    float world[3];
+    camera_to_world_direction(shot, cam, world);  // normalised
+    const float len = std::sqrt(cam[0] * cam[0] + cam[1] * cam[1] + 1.0f);  // distance per unit view depth
+    // Own surface: a surface within the slack of the vertex's depth along the texel ray, and none
+    // in front of that window. Both rays start at the window's near end, next to the mesh (vcglib's
+    // grid walk is reliable from there, as for the vertex rays).
+    const vcg::Point3f dir(world[0], world[1], world[2]);
+    const float near_depth = std::max(vertex_depth - slack, 0.0f);
+    const vcg::Point3f window = centre + dir * (near_depth * len);
+    const bool surface_in_window = first_hit(marks, window, dir, (vertex_depth + slack - near_depth) * len) <
+                                   std::numeric_limits<float>::infinity();
+    if (surface_in_window && !blocked(marks, window, -dir, near_depth * len)) mask |= footprint_texel_bit(k);
   }
   return mask == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | mask);
 }

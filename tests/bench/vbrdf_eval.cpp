@@ -15,6 +15,11 @@
 //              [--below-baselines]
 // --photo-dir / --training-photo-dir: take each raster's photo (same file name) from DIR instead
 //   (e.g. 16-bit linear/).
+// --predict: how the product predicts a held-out sample. render (default): as the camera records
+// it (relight.h RelightOptions::rendered): the vertex's model where its pixel footprint shows its
+// own surface, the model rendered with 4x4 subpixels where it covers background or another surface
+// (silhouettes, contacts); vertex: the vertex's model alone (ignores what else the footprint covers).
+// --gt-lit: ground-truth lit flags per held-out light (load_lit below) instead of our shadow passes.
 // --gt-visible: score only vertices whose uchar `visible` property (ground-truth PLY, same vertex
 //   order as the result) is non-zero.
 // --max-mean-de / --max-p95-de: bounds on the whole-surface product figure.
@@ -25,6 +30,7 @@
 // Exit status 1 when a bound is exceeded (or nothing was scored), 2 on bad input.
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -36,6 +42,7 @@
 #include "pipeline.h"
 #include "project.h"
 #include "relight.h"
+#include "relight_render.h"
 #include "result_ply.h"
 #include "visibility_gl.h"
 
@@ -76,13 +83,35 @@ std::vector<uint8_t> load_visible(const std::string &path, const MeshData &mesh)
   return visible;
 }
 
+// Ground-truth "lit" per held-out light and vertex: a text file whose first line is
+// "<vertices> <lights>", then one line per vertex of <lights> characters '0'/'1' (light order =
+// the held-out project's rasters). tests/benchmark/whole_surface_eval.sh writes it from the
+// scenes' gt_vertex.npz (heldout_lit). Returned raster-major, as RelightOptions::lit_filter.
+std::vector<uint8_t> load_lit(const std::string &path, size_t vertices, size_t rasters) {
+  std::ifstream in(path);
+  size_t n = 0, h = 0;
+  if (!(in >> n >> h)) throw InputError(path + ": expected '<vertices> <lights>' on the first line");
+  if (n != vertices || h != rasters)
+    throw InputError(path + " is for " + std::to_string(n) + " vertices x " + std::to_string(h) + " lights; the result has " +
+                     std::to_string(vertices) + " vertices and the held-out project " + std::to_string(rasters) + " photos");
+  std::vector<uint8_t> lit(n * h, 0);
+  std::string line;
+  for (size_t v = 0; v < n; ++v) {
+    if (!(in >> line) || line.size() != h) throw InputError(path + ": line " + std::to_string(v + 2) + " is not " +
+                                                            std::to_string(h) + " characters of 0/1");
+    for (size_t r = 0; r < h; ++r) lit[r * n + v] = line[r] == '1';
+  }
+  return lit;
+}
+
 void row(const char *name, const ErrorSummary &s) {
   std::printf("  %-44s %9zu %8.3f %8.3f %8.3f\n", name, s.samples, s.mean, s.median, s.p95);
 }
 } // namespace
 
 int main(int argc, char **argv) {
-  std::string result_path, mlp, lp, photo_dir, backend = "gl", train_mlp, train_lp, train_photo_dir, gt_path;
+  std::string result_path, mlp, lp, photo_dir, backend = "gl", train_mlp, train_lp, train_photo_dir, gt_path,
+      gt_lit_path, predict = "render";
   double max_mean = -1, max_p95 = -1, max_clean_mean = -1, max_clean_p95 = -1;
   bool below_baselines = false;
   for (int i = 1; i < argc; ++i) {
@@ -105,6 +134,8 @@ int main(int argc, char **argv) {
     else if (a == "--training-lp") train_lp = v;
     else if (a == "--training-photo-dir") train_photo_dir = v;
     else if (a == "--gt-visible") gt_path = v;
+    else if (a == "--gt-lit") gt_lit_path = v;
+    else if (a == "--predict") predict = v;
     else if (a == "--max-mean-de") max_mean = std::stod(v);
     else if (a == "--max-p95-de") max_p95 = std::stod(v);
     else if (a == "--max-clean-mean-de") max_clean_mean = std::stod(v);
@@ -117,7 +148,8 @@ int main(int argc, char **argv) {
   if (result_path.empty() || mlp.empty() || (below_baselines && train_mlp.empty())) {
     std::cerr << "usage: vbrdf_eval --result fit.ply --project heldout/project.mlp [--lp F] [--photo-dir D]\n"
                  "                  [--visibility gl|cpu] [--training train.mlp [--training-lp F]\n"
-                 "                  [--training-photo-dir D]] [--gt-visible gt_vertex.ply]\n"
+                 "                  [--training-photo-dir D]] [--gt-visible gt_vertex.ply] [--gt-lit lit.txt]\n"
+                 "                  [--predict render|vertex]\n"
                  "                  [--max-mean-de X] [--max-p95-de Y] [--max-clean-mean-de X] [--max-clean-p95-de Y]\n"
                  "                  [--below-baselines (needs --training)]\n";
     return 2;
@@ -138,6 +170,11 @@ int main(int argc, char **argv) {
       visible = load_visible(gt_path, result.mesh);
       options.vertex_filter = &visible;
     }
+    std::vector<uint8_t> lit;
+    if (!gt_lit_path.empty()) {
+      lit = load_lit(gt_lit_path, result.mesh.view().vertex_count, heldout.project.rasters.size());
+      options.lit_filter = &lit;
+    }
     std::unique_ptr<test::OsMesaContext> context;
     std::unique_ptr<VisibilityBackend> visibility;
     if (backend == "gl") {
@@ -146,19 +183,35 @@ int main(int argc, char **argv) {
     } else {
       visibility = make_cpu_visibility(result.mesh.view(), VisibilitySettings());
     }
+    std::vector<FineRender> rendered;
+    std::unique_ptr<RelightRenderer> renderer;
+    if (predict == "render") {
+      if (!context) context.reset(new test::OsMesaContext());
+      renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address()));
+      for (size_t r = 0; r < heldout.project.rasters.size(); ++r)
+        rendered.push_back(render_supersampled(*renderer, heldout.project.rasters[r].shot, heldout.lights[r].data()));
+      options.rendered = &rendered;
+    } else if (predict != "vertex") {
+      throw InputError("--predict takes 'render' or 'vertex'");
+    }
     const RelightStats s =
         evaluate_relighting(result.mesh.view(), fits, heldout.project.rasters, heldout.lights, *visibility, options);
 
     const auto &rasters = heldout.project.rasters;
-    std::printf("relit on %zu held-out photos%s; scored vertices: %s\n", rasters.size(),
+    std::printf("relit on %zu held-out photos%s; scored vertices: %s; lit as %s says\n", rasters.size(),
                 s.has_baselines ? ", baselines from the training photos of the same camera" : "",
-                gt_path.empty() ? "all" : "ground-truth visible");
+                gt_path.empty() ? "all" : "ground-truth visible",
+                gt_lit_path.empty() ? "our shadow passes" : "the ground truth");
     std::printf("  %-44s %9s %8s %8s %8s\n", "CIEDE2000", "samples", "mean", "median", "p95");
     row("whole surface: product", ErrorSummary{s.samples, s.mean_de2000, s.median_de2000, s.p95_de2000});
     if (s.has_baselines) {
       row("  same samples with training data: product", s.product_on_baseline_set);
       row("  same samples: PTM (per pixel)", s.ptm);
       row("  same samples: RBF (per pixel, Relight-style)", s.rbf);
+      row("  clean footprint: product", s.product_clean_footprint);
+      row("  clean footprint: RBF", s.rbf_clean_footprint);
+      row("  mixed footprint (silhouette/contact): product", s.product_mixed_footprint);
+      row("  mixed footprint (silhouette/contact): RBF", s.rbf_mixed_footprint);
       std::printf("  (%zu whole-surface samples without training data are excluded from these three rows)\n",
                   s.baseline_excluded);
     }

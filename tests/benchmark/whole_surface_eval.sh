@@ -47,8 +47,21 @@ for scene in $scenes; do
     status=1
     continue
   fi
+  # Ground-truth lit flags (gt_vertex.npz heldout_lit) as the text file vbrdf_eval --gt-lit reads;
+  # without numpy the evaluation falls back to our own shadow passes (and says so).
+  lit_opt=""
+  if /usr/bin/python3 - "$s/gt_vertex.npz" "$out/gt_lit.txt" <<'PY' 2>/dev/null; then lit_opt="--gt-lit $out/gt_lit.txt"; fi
+import sys
+import numpy as np
+lit = np.load(sys.argv[1])["heldout_lit"].astype(bool)
+with open(sys.argv[2], "w") as f:
+    f.write(f"{lit.shape[0]} {lit.shape[1]}\n")
+    for row in lit:
+        f.write("".join("1" if b else "0" for b in row) + "\n")
+PY
+  # shellcheck disable=SC2086
   "$eval_tool" --result "$out/fit.ply" --project "$s/heldout/project.mlp" --photo-dir "$s/heldout/linear" \
-      --training "$s/project.mlp" --training-photo-dir "$s/linear" --gt-visible "$s/gt_vertex.ply" "$@" \
+      --training "$s/project.mlp" --training-photo-dir "$s/linear" --gt-visible "$s/gt_vertex.ply" $lit_opt "$@" \
       > "$out/eval.log" 2>&1
   rc=$?
   cat "$out/eval.log"
