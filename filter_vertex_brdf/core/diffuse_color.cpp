@@ -73,6 +73,9 @@ void estimate_diffuse_chunk(const SampleChunk &chunk, DiffuseEstimate *out) {
           s.flags = uint16_t(s.flags & ~kMixedPixel);
           if (is_diffuse_sample(s)) used.push_back(s), est.from_mixed_pixels = true;
         }
+      est.from_rim_pixels = !used.empty() && std::all_of(used.begin(), used.end(), [](const Sample &s) {
+        return (s.flags & kRimFootprint) != 0;
+      });
       if (least_squares_reflectance(used.data(), used.size(), est.rgb)) {
         est.n_rejected = uint16_t(reject_outliers(used, est.rgb));
         if (est.n_rejected) least_squares_reflectance(used.data(), used.size(), est.rgb);

@@ -27,6 +27,8 @@ struct DiffuseEstimate {
   uint16_t n_rejected = 0;    // diffuse samples rejected as outliers
   bool valid = false;         // at least one diffuse sample
   bool from_mixed_pixels = false;  // estimated from mixed-pixel samples only
+  bool from_rim_pixels = false;    // estimated from rim samples (kRimFootprint) only: the vertex
+                                   //   lies on a silhouette or contact in every photo that sees it
 };
 
 // Least-squares reflectance of `count` samples (all assumed diffuse-usable). Returns false when

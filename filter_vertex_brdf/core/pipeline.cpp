@@ -286,8 +286,9 @@ std::string color_report(const FitResult &r, const FitSettings &settings) {
 }
 
 // Everything the chunk consumer produces, per vertex.
-void consume_chunk(const SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options, FitResult &r,
+void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options, FitResult &r,
                    double &fit_seconds) {
+  r.rim_samples_demoted += prefer_clean_samples(chunk);
   estimate_diffuse_chunk(chunk, &r.diffuse[chunk.first_vertex]);
   if (!fitter) return;
   const auto t = Clock::now();
@@ -354,8 +355,9 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     const bool coloured = displayed_reflectance(r, v, rho);
     for (int c = 0; c < 3; ++c) attr(size_t(c))[v] = rho[c];
     attr(3)[v] = e.n_seen, attr(4)[v] = e.n_diffuse, attr(5)[v] = e.n_specular;
-    const bool mixed = r.fits.empty() ? e.from_mixed_pixels
-                                      : (r.fits[v].status == kFitFromWeakSamples && e.from_mixed_pixels);
+    // coloured = 2: the colour comes only from pixels at a silhouette or contact (own-surface texels
+    // of a straddling footprint, or mixed pixels): lower confidence than clean pixels.
+    const bool mixed = e.from_mixed_pixels || e.from_rim_pixels;
     const bool from_neighbours = !r.fits.empty() && r.fits[v].status == kFitFromNeighbours;
     attr(6)[v] = coloured ? (from_neighbours ? 3.0f : mixed ? 2.0f : 1.0f) : 0.0f;
     if (!r.fits.empty()) {
@@ -402,10 +404,13 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   const std::pair<uint16_t, const char *> flag_names[] = {
       {kOffImage, "off image / behind camera"}, {kBackFacing, "back-facing"}, {kOccluded, "occluded"},
       {kAttachedShadow, "facing away from the light"}, {kCastShadow, "in cast shadow"},
-      {kSaturated, "saturated (not used)"}, {kMixedPixel, "mixed pixel at a silhouette/border (not used)"},
+      {kSaturated, "saturated (not used)"},
+      {kMixedPixel, "mixed pixel at a silhouette/contact, no own-surface texel (used only where nothing else is: fit_status 4)"},
+      {kRimFootprint, "rim footprint: colour from its own-surface texels (used where the vertex has < 2 clean samples)"},
       {kGrazing, "grazing light (N.L < T_d)"}, {kHighlight, "highlight (R.E > T_s)"}};
   for (const auto &f : flag_names)
     rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
+  rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
   for (size_t i = 0; i < input.rasters.size(); ++i)
     if (g.raster_seen_vertices[i] == 0)
       rep << "skipped: raster '" << input.rasters[i].label << "' sees no vertex (check its registration); its photo was not read\n";

@@ -84,6 +84,7 @@ struct FitResult {
   std::string fit_backend;                // name of the fit back end ("" when not fitted)
   size_t fit_full = 0, fit_diffuse_only = 0, fit_none = 0, fit_converged = 0, fit_iterations = 0;
   size_t fit_weak = 0, fit_neighbours = 0;  // fit_status 4 and 3
+  size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
   NeighbourFillStats fill;
   double seconds_fit = 0;
   std::string light_file;                 // the .lp used

@@ -252,4 +252,19 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
   return stats;
 }
 
+size_t prefer_clean_samples(SampleChunk &chunk, int min_clean) {
+  size_t demoted = 0;
+#pragma omp parallel for reduction(+ : demoted) schedule(dynamic, 1024)
+  for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
+    Sample *first = chunk.samples.data() + chunk.offsets[size_t(i)];
+    Sample *last = chunk.samples.data() + chunk.offsets[size_t(i) + 1];
+    int clean = 0;
+    for (const Sample *s = first; s != last; ++s) clean += is_diffuse_sample(*s) && !(s->flags & kRimFootprint);
+    if (clean < min_clean) continue;
+    for (Sample *s = first; s != last; ++s)
+      if (s->flags & kRimFootprint) s->flags |= kMixedPixel, ++demoted;
+  }
+  return demoted;
+}
+
 } // namespace vbrdf

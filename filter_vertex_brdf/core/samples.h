@@ -139,4 +139,11 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
                            const GatherSettings &settings, PhotoCache &photos,
                            const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress = {});
 
+// Rim samples (kRimFootprint: colour from part of a footprint that straddles a silhouette or
+// contact) still carry some of the other side through the sensor's pixel area. A vertex with at
+// least `min_clean` clean diffuse samples (is_diffuse_sample without kRimFootprint) does not need
+// them: its rim samples are marked kMixedPixel (left out by the strict fit and the diffuse
+// estimate, like every back end's). Vertices with fewer keep them. Returns the samples demoted.
+size_t prefer_clean_samples(SampleChunk &chunk, int min_clean = 2);
+
 } // namespace vbrdf

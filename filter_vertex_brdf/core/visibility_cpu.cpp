@@ -112,6 +112,11 @@ public:
 private:
   // True when a triangle lies on the ray from `from` along unit `dir` within (0, max_dist].
   bool blocked(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist);
+  // vcglib's grid walk misses hits on rays that start outside the grid's box (e.g. above a flat
+  // mesh): such rays are started where they enter the box, just inside it. False when the ray
+  // misses the box within max_dist; `skipped` is the distance moved.
+  bool clip_to_grid(const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist, vcg::Point3f &start,
+                    float &skipped) const;
   // Distance to the first triangle along the ray within max_dist, or +infinity when none.
   float first_hit(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist);
   // kCameraClear or kFootprintPartial | mask for a visible vertex (visibility.h): one ray per
@@ -145,21 +150,45 @@ CpuVisibility::CpuVisibility(const MeshView &mesh, const VisibilitySettings &set
   if (!triangles_.empty()) grid_.Set(triangles_.begin(), triangles_.end());
 }
 
+bool CpuVisibility::clip_to_grid(const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist,
+                                 vcg::Point3f &start, float &skipped) const {
+  skipped = 0;
+  start = from;
+  if (grid_.bbox.IsIn(from)) return true;
+  float t_enter = 0, t_exit = max_dist;
+  for (int k = 0; k < 3; ++k) {
+    // Shrunk by a hair so that the start point lies strictly inside (IsIn) after rounding.
+    const float pad = 1e-6f * (grid_.bbox.max[k] - grid_.bbox.min[k]);
+    const float lo = grid_.bbox.min[k] + pad, hi = grid_.bbox.max[k] - pad;
+    if (std::fabs(dir[k]) < 1e-30f) {
+      if (from[k] < lo || from[k] > hi) return false;
+      continue;
+    }
+    float a = (lo - from[k]) / dir[k], b = (hi - from[k]) / dir[k];
+    if (a > b) std::swap(a, b);
+    t_enter = std::max(t_enter, a);
+    t_exit = std::min(t_exit, b);
+  }
+  if (!(t_enter <= t_exit)) return false;
+  skipped = t_enter;
+  start = from + dir * t_enter;
+  return true;
+}
+
 bool CpuVisibility::blocked(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist) {
-  if (triangles_.empty() || !(max_dist > 0)) return false;
-  RayTriangleHit hit;
-  StampMarker marker(&marks, triangles_.data());
-  float t = 0;
-  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) != nullptr;
+  return first_hit(marks, from, dir, max_dist) < std::numeric_limits<float>::infinity();
 }
 
 float CpuVisibility::first_hit(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist) {
   const float none = std::numeric_limits<float>::infinity();
   if (triangles_.empty() || !(max_dist > 0)) return none;
+  vcg::Point3f start;
+  float skipped = 0;
+  if (!clip_to_grid(from, dir, max_dist, start, skipped)) return none;
   RayTriangleHit hit;
   StampMarker marker(&marks, triangles_.data());
   float t = 0;
-  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(from, dir), max_dist, t) ? t : none;
+  return vcg::GridDoRay(grid_, hit, marker, vcg::Ray3f(start, dir), max_dist - skipped, t) ? skipped + t : none;
 }
 
 uint8_t CpuVisibility::footprint_code(MarkState &marks, const Shot &shot, const vcg::Point3f &centre,

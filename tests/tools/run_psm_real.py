@@ -154,15 +154,32 @@ def check_object(args, name):
         if not failures:
             failures += sampling_check(args, name, fit, mask)
 
-    rc, text = run([args.eval_tool, '--result', fit_ply, '--project', os.path.join(out, 'heldout', 'project.mlp')])
+    # Acceptance (issue 9): over every object pixel (one vertex per pixel) at the held-out lights,
+    # the product below per-pixel PTM and RBF fitted on the same training photos, in mean and p95,
+    # and no seen vertex without a model.
+    rc, text = run([args.eval_tool, '--result', fit_ply, '--project', os.path.join(out, 'heldout', 'project.mlp'),
+                    '--training', os.path.join(out, 'project.mlp'), '--below-baselines'])
     print('\n'.join('   ' + l for l in text.splitlines()))
-    m = re.search(r'(\d+) samples, CIEDE2000 mean ([-\d.naif]+), median [-\d.naif]+, p95 ([-\d.naif]+)', text)
-    if rc != 0 or not m:
-        failures.append('%s: vbrdf_eval exited %d' % (name, rc))
-    elif not (int(m.group(1)) > 0 and np.isfinite(float(m.group(2))) and np.isfinite(float(m.group(3)))):
+    rows = {}
+    for label, key in (('whole surface: product', 'product'), ('same samples: PTM', 'ptm'),
+                       ('same samples: RBF', 'rbf')):
+        m = re.search(re.escape(label) + r'[^\n]*?\s(\d+)\s+([-\d.naif]+)\s+([-\d.naif]+)\s+([-\d.naif]+)\n', text)
+        if m:
+            rows[key] = (int(m.group(1)), float(m.group(2)), float(m.group(4)))
+    unmodelled = re.search(r'seen vertices without a model: (\d+) of (\d+)', text)
+    if len(rows) != 3 or not unmodelled:
+        failures.append('%s: vbrdf_eval output not understood (exit %d)' % (name, rc))
+        return failures
+    if not all(np.isfinite(v[1]) and np.isfinite(v[2]) and v[0] > 0 for v in rows.values()):
         failures.append('%s: vbrdf_eval figures not finite or no samples' % name)
-    else:
-        print('  RESULT %s: relit CIEDE2000 mean %s, p95 %s (%s samples)' % (name, m.group(2), m.group(3), m.group(1)))
+    print('  RESULT %s: whole surface relit CIEDE2000 mean/p95: product %.3f/%.3f, PTM %.3f/%.3f, RBF %.3f/%.3f; '
+          'seen vertices without a model %s of %s' % (name, rows['product'][1], rows['product'][2], rows['ptm'][1],
+                                                      rows['ptm'][2], rows['rbf'][1], rows['rbf'][2],
+                                                      unmodelled.group(1), unmodelled.group(2)))
+    if rc != 0:
+        failures.append('%s: product not below both per-pixel baselines in mean and p95 (vbrdf_eval exit %d)' % (name, rc))
+    if int(unmodelled.group(1)) != 0:
+        failures.append('%s: %s seen vertices without a model' % (name, unmodelled.group(1)))
     return failures
 
 
