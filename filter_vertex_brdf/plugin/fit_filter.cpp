@@ -27,6 +27,7 @@ const char *const kFitBackend = "fitBackend";
 const char *const kInitialShininess = "initialShininess";
 const char *const kMaxIterations = "maxIterations";
 const char *const kMinSpecularSamples = "minSpecularSamples";
+const char *const kFillUnseenRings = "fillUnseenRings";
 const char *const kQualityOutput = "qualityOutput";
 const char *const kColorCorrection = "colorCorrection";
 const char *const kChartCorners = "chartCorners";
@@ -167,6 +168,11 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                           "Highlight samples (R.E above the specular threshold, lit, unsaturated) a vertex "
                           "needs before k_s and shininess are fitted; with fewer the vertex gets a "
                           "diffuse-only fit (k_s = 0). Guards against 'diffuse holes' (k_d ~ 0, huge k_s)."));
+  params.addParam(RichInt(kFillUnseenRings, 0, "Fill unseen gaps (rings)",
+                          "Vertices no photo sees keep no model and their input colour. Give N > 0 to let "
+                          "those within N edges of a modelled vertex take their neighbours' parameters "
+                          "(fit_status 3, like seen vertices without a usable sample, which are always filled). "
+                          "0 = off."));
   params.addParam(RichEnum(kQualityOutput, 0, QStringList() << "Diffuse quality (DQ)" << "Specular quality (SQ)"
                                                              << "Fit RMSE",
                            "Vertex quality",
@@ -224,6 +230,8 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(iterations >= 0 && iterations <= 10000, kMaxIterations, "must be in [0, 10000]");
   const int min_specular = params.getInt(kMinSpecularSamples);
   require(min_specular >= 1 && min_specular <= 1000, kMinSpecularSamples, "must be in [1, 1000]");
+  const int fill_rings = params.getInt(kFillUnseenRings);
+  require(fill_rings >= 0 && fill_rings <= 1000, kFillUnseenRings, "must be in [0, 1000]");
   const int quality = params.getEnum(kQualityOutput);
   require(quality >= 0 && quality <= 2, kQualityOutput, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
   const int color = params.getEnum(kColorCorrection);
@@ -244,6 +252,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.phong.alpha_init = alpha0;
   s.phong.max_iterations = iterations;
   s.phong.min_specular_samples = min_specular;
+  s.fill_unseen_rings = fill_rings;
   s.quality = vbrdf::QualityOutput(quality);
   s.color_correction = vbrdf::ColorCorrectionChoice(color);  // same order as the enum's entries
   s.chart_corners = parse_corners(params.getString(kChartCorners));

@@ -76,6 +76,19 @@ def check(out_path, input_mesh_path, gt_path, fit="scalar", max_rel=None, max_de
         failures.append("vertex colours of coloured vertices are not the sRGB encoding of diffuse_r/g/b")
     if np.any(est[coloured] < 0):
         failures.append("negative diffuse reflectance")
+    if "fit_status" in v.dtype.names:
+        # Issue 9: every vertex a photo sees has a model, and one consistent output: the written
+        # diffuse reflectance is the model's k_d C.
+        modelled = v["fit_status"] > 0.5
+        if np.any(~unseen & ~modelled):
+            failures.append(f"{int(np.sum(~unseen & ~modelled))} vertices seen by a photo have no model "
+                            f"(fit_status 0)")
+        kd_c = v["kd"][:, None].astype(np.float64) * np.stack([v["color_r"], v["color_g"], v["color_b"]], 1)
+        apart = modelled & (np.abs(kd_c - est).max(axis=1) > 1e-4 * np.maximum(1.0, est.max(axis=1)))
+        if np.any(apart):
+            failures.append(f"{int(apart.sum())} modelled vertices have diffuse_r/g/b different from k_d * color")
+        if np.any(modelled & ~coloured):
+            failures.append(f"{int(np.sum(modelled & ~coloured))} modelled vertices are not coloured")
 
     report = {"vertices": n, "coloured": int(coloured.sum()), "unseen": int(unseen.sum()),
               "seen_without_estimate": int((~coloured & ~unseen).sum()), "fit": fit}

@@ -131,7 +131,7 @@ class ScriptTest(unittest.TestCase):
                  "diffuseThreshold": "RichFloat", "photoEncoding": "RichEnum", "saturationLevel": "RichFloat",
                  "visibilityBackend": "RichEnum", "depthTolerance": "RichFloat", "shadowMapSize": "RichInt",
                  "memoryBudgetMB": "RichInt", "fitReflectance": "RichBool", "fitBackend": "RichEnum",
-                 "initialShininess": "RichFloat", "maxIterations": "RichInt", "minSpecularSamples": "RichInt",
+                 "initialShininess": "RichFloat", "maxIterations": "RichInt", "minSpecularSamples": "RichInt", "fillUnseenRings": "RichInt",
                  "qualityOutput": "RichEnum", "colorCorrection": "RichEnum", "chartCorners": "RichString",
                  "exposureNormalisation": "RichEnum"}
         self.assertEqual({n: p.get("type") for n, p in params.items()}, types)
@@ -224,6 +224,25 @@ class CheckOutputTest(unittest.TestCase):
         names = [n for n in self.out_vertex.dtype.names if n != "n_specular"]
         r = self.run_check(self.out_vertex[names])
         self.assertTrue(any("n_specular" in f for f in r["failures"]))
+
+    def test_seen_vertex_without_model_and_inconsistent_reflectance_are_reported(self):
+        names = list(self.out_vertex.dtype.names) + ["kd", "color_r", "color_g", "color_b", "fit_status"]
+        v = np.zeros(len(self.out_vertex), dtype=[(n, self.out_vertex.dtype[n] if n in self.out_vertex.dtype.names
+                                                    else np.float32) for n in names])
+        for n in self.out_vertex.dtype.names:
+            v[n] = self.out_vertex[n]
+        rho = np.stack([v["diffuse_r"], v["diffuse_g"], v["diffuse_b"]], 1)
+        v["kd"] = rho.max(axis=1)
+        for i, c in enumerate(("color_r", "color_g", "color_b")):
+            v[c] = np.where(v["kd"] > 0, rho[:, i] / np.maximum(v["kd"], 1e-30), 0)
+        v["fit_status"] = np.where(v["n_visible"] > 0, 1, 0)
+        self.assertEqual(self.run_check(v)["failures"], [])
+        w = v.copy()
+        w["fit_status"][1] = 0
+        self.assertTrue(any("have no model" in f for f in self.run_check(w)["failures"]))
+        w = v.copy()
+        w["kd"][2] *= 1.1
+        self.assertTrue(any("different from k_d * color" in f for f in self.run_check(w)["failures"]))
 
     def test_changed_geometry_and_bad_colour_are_reported(self):
         v = self.out_vertex.copy()

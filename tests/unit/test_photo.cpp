@@ -90,3 +90,33 @@ TEST(PhotoCache, StaysUnderBudgetAndReloads) {
   cache.get(a);
   EXPECT_EQ(cache.loads(), 3u);
 }
+
+namespace vbrdf {
+namespace {
+// A footprint mask keeps only some texels (the vertex's own surface at a silhouette): the sample
+// is their renormalised bilinear mix; saturation elsewhere in the footprint does not count.
+TEST(Photo, MaskedBilinearUsesOnlyTheKeptTexels) {
+  cv::Mat img(2, 2, CV_16UC3, cv::Scalar(0, 0, 0));
+  img.at<cv::Vec3w>(0, 0) = cv::Vec3w(0, 0, 10000);  // R: texel bit 0 (top-left)
+  img.at<cv::Vec3w>(0, 1) = cv::Vec3w(0, 0, 30000);  // bit 1 (top-right)
+  img.at<cv::Vec3w>(1, 0) = cv::Vec3w(0, 0, 50000);  // bit 2 (bottom-left)
+  img.at<cv::Vec3w>(1, 1) = cv::Vec3w(65535, 65535, 65535);  // bit 3: clipped
+  const std::string path = (std::string(::testing::TempDir()) + "masked.png");
+  ASSERT_TRUE(cv::imwrite(path, img));
+  const Photo p = load_photo(path, PhotoEncoding::Linear);
+  // At (0.75, 0.75) the bilinear weights are 0.5625, 0.1875, 0.1875, 0.0625.
+  PixelSample all = sample_bilinear(p, 0.75f, 0.75f);
+  EXPECT_TRUE(all.saturated);
+  PixelSample top = sample_bilinear(p, 0.75f, 0.75f, 0x3);  // texels 0 and 1: weights 0.75 : 0.25
+  ASSERT_TRUE(top.inside);
+  EXPECT_FALSE(top.saturated);
+  EXPECT_NEAR(top.rgb[0], (0.75f * 10000 + 0.25f * 30000) / 65535.0f, 1e-5);
+  PixelSample left = sample_bilinear(p, 0.75f, 0.75f, 0x5);  // texels 0 and 2
+  EXPECT_NEAR(left.rgb[0], (0.75f * 10000 + 0.25f * 50000) / 65535.0f, 1e-5);
+  // A kept texel with (almost) no bilinear weight: the kept texels are averaged instead.
+  PixelSample far = sample_bilinear(p, 0.5f, 0.5f, 0x2);  // exactly on texel 0's centre
+  EXPECT_NEAR(far.rgb[0], 30000 / 65535.0f, 1e-5);
+  EXPECT_FALSE(sample_bilinear(p, 0.75f, 0.75f, 0).inside);  // nothing kept: no sample
+}
+} // namespace
+} // namespace vbrdf

@@ -136,3 +136,43 @@ TEST(Samples, MasksTellWhetherARasterSeesAChunk) {
   EXPECT_TRUE(m.sees_any(0, 100, 34));
   EXPECT_FALSE(m.sees_any(0, 10, 0));
 }
+
+namespace vbrdf {
+namespace {
+// A vertex next to the white pixel: a footprint straddling a depth jump keeps its own-surface
+// texels (kRimFootprint, colour from them) or, with none left or for the evaluation's plain
+// bilinear, the whole footprint (kMixedPixel).
+TEST(Samples, RimFootprintsUseTheirOwnSurfaceTexels) {
+  Fixture f;
+  // Image point (11.0, 11.0): footprint texels (10,10) white [bit 0], (11,10), (10,11), (11,11).
+  const float p[3] = {(11.0f - 32) / 50.0f, (24 - 11.0f) / 50.0f, 0};
+  const float side60[3] = {0.8660254f, 0, 0.5f};
+  Sample own{}, plain{}, none{};
+  make_sample(p, kFacing, f.raster, 0, side60, f.photo, true, true, f.settings, own, 0xE);  // white texel not own
+  EXPECT_EQ(own.flags, kRimFootprint);
+  EXPECT_NEAR(own.rgb[0], srgb_to_linear(200 / 255.0f), 1e-5);  // the white texel left out
+  EXPECT_TRUE(is_diffuse_sample(own));
+  GatherSettings evaluation = f.settings;
+  evaluation.own_surface_texels = false;
+  make_sample(p, kFacing, f.raster, 0, side60, f.photo, true, true, evaluation, plain, 0xE);
+  EXPECT_EQ(plain.flags, kMixedPixel | kSaturated);  // as sampled: the white texel included
+  make_sample(p, kFacing, f.raster, 0, side60, f.photo, true, true, f.settings, none, 0x0);
+  EXPECT_EQ(none.flags, kMixedPixel | kSaturated);
+  EXPECT_FALSE(is_diffuse_sample(none));
+}
+
+TEST(Samples, CleanSamplesArePreferredOverRimOnes) {
+  SampleChunk c;
+  c.first_vertex = 0;
+  c.vertex_count = 2;
+  auto s = [](uint16_t flags) { Sample x{}; x.n_dot_l = 0.8f; x.flags = flags; return x; };
+  // vertex 0: 2 clean + 1 rim -> the rim sample is left out; vertex 1: 1 clean + 1 rim -> kept.
+  c.samples = {s(0), s(0), s(kRimFootprint), s(0), s(kRimFootprint)};
+  c.offsets = {0, 3, 5};
+  EXPECT_EQ(prefer_clean_samples(c), 1u);
+  EXPECT_TRUE(c.samples[2].flags & kMixedPixel);
+  EXPECT_FALSE(c.samples[4].flags & kMixedPixel);
+  EXPECT_TRUE(is_diffuse_sample(c.samples[4]));
+}
+} // namespace
+} // namespace vbrdf
