@@ -50,6 +50,7 @@ SAMPLE_PROJECTS = ["synth_basic", "synth_two_views", "synth_linear16"]
 CSV_COLUMNS = ["scene", "axis", "mesh", "vertices", "photos", "backend", "iterations",
                "t_init", "t_prepare", "t_visibility", "t_gather", "t_fit", "t_output", "t_total",
                "t_total_max", "relit_mean", "relit_median", "relit_p95", "relit_psnr", "relit_pixels",
+               "ws_mean", "ws_p95", "ws_unmodelled_vertices", "ptm_mean", "ptm_p95", "rbf_mean", "rbf_p95",
                "rho_de_mean", "rho_de_p95", "coverage",
                "ks_rel_median", "alpha_rel_median", "glossy_determined", "full_fits", "converged",
                "alpha_iterations", "samples", "repeats", "pareto"]
@@ -387,9 +388,15 @@ def summary(rows, smoke):
         lines += ["## Shared scenes and sample projects", "",
                   table(sorted(others, key=lambda r: (r["scene"], r["axis"], r["backend"], r["photos"], r["iterations"])),
                         ["scene", "axis", "mesh", "vertices", "photos", "backend", "iterations", "t_total", "t_fit",
-                         "relit_mean", "relit_p95", "relit_psnr", "rho_de_mean", "coverage", "pareto"],
+                         "relit_mean", "relit_p95", "ws_mean", "ws_p95", "ptm_mean", "ptm_p95", "rbf_mean",
+                         "rbf_p95", "rho_de_mean", "coverage", "pareto"],
                         ["scene", "axis", "mesh", "vertices", "photos", "back end", "cap", "total s", "fit s",
-                         "relit dE mean", "relit dE p95", "PSNR dB", "rho dE", "coverage", "front"]), ""]
+                         "relit dE mean (interior)", "p95", "whole surface mean", "p95", "PTM mean", "p95",
+                         "RBF mean", "p95", "rho dE", "coverage", "front"]), "",
+                  "relit dE (interior): image space, lit interior pixels only (silhouettes and depth jumps left "
+                  "out). whole surface: every seen, lit, unsaturated vertex at its pixel (RTI protocol, "
+                  "vertices without a model black), beside per-pixel PTM and Relight-style RBF on the same "
+                  "samples (vbrdf_eval; tests/benchmark/whole_surface_eval.sh).", ""]
     rest = [r for r in synth if r["axis"] == "backend"]
     if rest:
         lines += ["## Synthetic: CPU visibility (ray cast) + CPU fit", "",

@@ -46,6 +46,7 @@
 #include "photo.h"
 #include "pipeline.h"
 #include "project.h"
+#include "relight.h"
 #include "relight_render.h"
 #include "result_ply.h"
 #include "visibility_gl.h"
@@ -275,7 +276,13 @@ HeldOut load_heldout(const Args &a) {
   return h;
 }
 
+// Held-out relit error two ways: image space over the lit interior pixels (relit_*: silhouettes
+// and depth jumps left out), and over the whole visible surface as RTI tools are judged (ws_*:
+// every seen, lit, unsaturated vertex sample, the held-out photo sampled bilinearly at the
+// vertex's pixel, vertices without a model black) beside per-pixel PTM and Relight-style RBF fitted
+// on the training photos of the same camera and scored on the same samples (relight.h).
 void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<VertexFit> &fits,
+                      const std::vector<Raster> &training, const std::vector<std::array<float, 3>> &training_lights,
                       const GetProcAddressFn &get_proc, Json &out) {
   const HeldOut h = load_heldout(a);
   const auto t = Clock::now();
@@ -290,6 +297,23 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
   out.num("relit_median", c.median_de2000);
   out.num("relit_p95", c.p95_de2000);
   out.num("relit_psnr", c.psnr_db);
+  std::vector<FineRender> rendered;
+  for (size_t r = 0; r < h.rasters.size(); ++r)
+    rendered.push_back(render_supersampled(renderer, h.rasters[r].shot, h.lights[r].data()));
+  auto visibility = make_gl_visibility(mesh.view(), get_proc, VisibilitySettings());
+  RelightOptions ro;
+  ro.rendered = &rendered;
+  ro.training_rasters = &training;
+  ro.training_light_dirs_world = &training_lights;
+  const RelightStats ws = evaluate_relighting(mesh.view(), fits, h.rasters, h.lights, *visibility, ro);
+  out.num("ws_samples", double(ws.samples));
+  out.num("ws_mean", ws.mean_de2000);
+  out.num("ws_p95", ws.p95_de2000);
+  out.num("ws_unmodelled_vertices", double(ws.seen_unmodelled_vertices));
+  out.num("ptm_mean", ws.ptm.mean);
+  out.num("ptm_p95", ws.ptm.p95);
+  out.num("rbf_mean", ws.rbf.mean);
+  out.num("rbf_p95", ws.rbf.p95);
   out.num("t_eval", since(t));
 }
 
@@ -357,7 +381,9 @@ int cmd_fit(const Args &a) {
   out.num("diffuse_only_fits", double(r.fit_diffuse_only));
   out.num("converged", double(r.fit_converged));
   out.num("alpha_iterations", double(r.fit_iterations));
-  if (!a.get("heldout").empty()) evaluate_heldout(a, mesh, r.fits, get_proc, out);
+  if (!a.get("heldout").empty())
+    evaluate_heldout(a, mesh, r.fits, input.rasters, resolve_light_directions(input.rasters, r.light_file), get_proc,
+                     out);
   if (!a.get("gt").empty()) {
     std::vector<float> n_specular;
     for (const VertexAttribute &attr : r.attributes)
