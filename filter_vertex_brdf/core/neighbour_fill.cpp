@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include <vcg/space/index/kdtree/kdtree.h>
+
 namespace vbrdf {
 
 namespace {
@@ -125,7 +127,36 @@ NeighbourFillStats fill_from_neighbours(const MeshView &mesh, const uint8_t *see
     }
     if (committed == 0) break;  // nothing could be averaged (no usable weight): stop, never loop
   }
-  for (size_t v = 0; v < n; ++v) stats.unreachable_seen += seen[v] && !model[v];
+  // Seen vertices in parts of the mesh without any modelled vertex (a small separate piece whose
+  // samples are all shadowed or clipped): the nearest modelled vertex in space (vcglib kd-tree).
+  std::vector<uint32_t> isolated, sources;
+  for (size_t v = 0; v < n; ++v) {
+    if (seen[v] && !model[v]) isolated.push_back(uint32_t(v));
+    if (model[v]) sources.push_back(uint32_t(v));
+  }
+  if (!isolated.empty() && !sources.empty()) {
+    std::vector<vcg::Point3f> points(sources.size());
+    for (size_t i = 0; i < sources.size(); ++i) {
+      const float *q = mesh.positions + 3 * size_t(sources[i]);
+      points[i] = vcg::Point3f(q[0], q[1], q[2]);
+    }
+    vcg::KdTree<float> tree(vcg::ConstDataWrapper<vcg::Point3f>(points.data(), int(points.size())));
+    for (uint32_t v : isolated) {
+      const float *p = mesh.positions + 3 * size_t(v);
+      unsigned int nearest = 0;
+      float distance = 0;
+      tree.doQueryClosest(vcg::Point3f(p[0], p[1], p[2]), nearest, distance);
+      VertexFit f = fits[sources[nearest]];
+      f.status = kFitFromNeighbours;
+      f.dq = f.sq = f.rmse = 0;
+      f.iterations = 0;
+      f.converged = 0;
+      fits[v] = f;
+      ++stats.filled_seen;
+      ++stats.filled_nearest;
+    }
+  }
+  for (size_t v = 0; v < n; ++v) stats.unreachable_seen += seen[v] && !has_model(fits[v]);
   return stats;
 }
 

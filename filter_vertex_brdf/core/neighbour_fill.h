@@ -13,8 +13,9 @@ namespace vbrdf {
 struct NeighbourFillStats {
   size_t filled_seen = 0;      // seen vertices given a model (status kFitFromNeighbours)
   size_t filled_unseen = 0;    // unseen vertices given a model (only with unseen_rings > 0)
-  size_t unreachable_seen = 0; // seen vertices left without a model: no modelled vertex in their
-                               //   connected part of the mesh
+  size_t filled_nearest = 0;   // of filled_seen: in a part of the mesh without any modelled
+                               //   vertex, from the nearest modelled vertex in space
+  size_t unreachable_seen = 0; // seen vertices left without a model: no modelled vertex at all
   int rings = 0;               // rings walked
 };
 
@@ -23,6 +24,8 @@ struct NeighbourFillStats {
 // vertex (seen[v] == 0) only when it lies within `unseen_rings` edges of a modelled vertex
 // (0 = never: vertices no photo sees keep "no model"). Propagation runs through filled vertices,
 // one ring per pass, each pass reading only the previous passes' results (order-independent).
+// A seen vertex whose connected part of the mesh has no modelled vertex copies the nearest
+// modelled vertex in space (a kd-tree over the modelled vertices).
 // Parameters: the average of the modelled edge neighbours, weighted by normal agreement
 // (max(N.N', 0) + 0.05) over edge length, with sources that are themselves filled or weak
 // (status 3/4) at half weight; rho = k_d C and k_s averaged, shininess averaged in log space

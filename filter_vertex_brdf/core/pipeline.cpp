@@ -322,9 +322,12 @@ void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &
   if (r.fill.filled_seen || r.fill.filled_unseen)
     log("Neighbour fill: " + std::to_string(r.fill.filled_seen) + " seen vertices without a usable sample and " +
         std::to_string(r.fill.filled_unseen) + " unseen vertices took their neighbours' parameters (fit_status 3).");
+  if (r.fill.filled_nearest)
+    log("Neighbour fill: " + std::to_string(r.fill.filled_nearest) +
+        " of them lie in a part of the mesh without any modelled vertex and copied the nearest modelled vertex in space.");
   if (r.fill.unreachable_seen)
     log("Neighbour fill: " + std::to_string(r.fill.unreachable_seen) +
-        " seen vertices have no usable sample and no modelled vertex in their part of the mesh: left without a model.");
+        " seen vertices have no usable sample and no vertex of the mesh has a model: left without a model.");
 }
 
 // Linear diffuse reflectance shown and written: the fitted k_d C where the Phong fit has samples,

@@ -69,7 +69,7 @@ TEST(NeighbourFill, UnseenVerticesOnlyWithinTheRingLimit) {
   for (size_t v = 0; v < h.fits.size(); ++v) EXPECT_EQ(has_model(h.fits[v]), Half::column(v) < 7) << v;
 }
 
-TEST(NeighbourFill, MixesNeighboursAndReportsUnreachableParts) {
+TEST(NeighbourFill, MixesNeighboursAndFillsSeparatePiecesFromTheNearest) {
   // Two materials side by side and a separate triangle far away that is seen but has no model.
   Half h;
   for (size_t v = 0; v < h.fits.size(); ++v)
@@ -81,7 +81,8 @@ TEST(NeighbourFill, MixesNeighboursAndReportsUnreachableParts) {
   h.fits.resize(base + 3, VertexFit{});
   h.seen.resize(base + 3, 1);
   const NeighbourFillStats s = fill_from_neighbours(h.mesh.view(), h.seen.data(), 0, h.fits.data());
-  EXPECT_EQ(s.unreachable_seen, 3u);
+  EXPECT_EQ(s.unreachable_seen, 0u);
+  EXPECT_EQ(s.filled_nearest, 3u);  // the far triangle copies the nearest modelled vertex (corner)
   for (size_t v = 0; v < base; ++v) {
     ASSERT_TRUE(has_model(h.fits[v]));
     const VertexFit &f = h.fits[v];
@@ -91,7 +92,14 @@ TEST(NeighbourFill, MixesNeighboursAndReportsUnreachableParts) {
       EXPECT_LT(f.kd * f.color[0], 0.5f - 1e-3f);
     }
   }
-  for (size_t v = base; v < base + 3; ++v) EXPECT_EQ(h.fits[v].status, kFitNone);
+  const VertexFit &corner = h.fits[10 * 11 + 10];  // grid vertex nearest to (5, 0, 5)
+  for (size_t v = base; v < base + 3; ++v) {
+    EXPECT_EQ(h.fits[v].status, kFitFromNeighbours);
+    EXPECT_EQ(h.fits[v].kd, corner.kd);
+  }
+  // Nothing modelled anywhere: nothing to copy, every seen vertex stays without a model.
+  std::vector<VertexFit> none(h.fits.size(), VertexFit{});
+  EXPECT_EQ(fill_from_neighbours(h.mesh.view(), h.seen.data(), 0, none.data()).unreachable_seen, h.fits.size());
 }
 
 // Samples of a Lambertian vertex rho = (0.6, 0.4, 0.2).
