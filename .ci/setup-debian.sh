@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Idempotent set-up of a Debian 12 machine (as root) for building and testing filter_vertex_brdf.
 #  - installs the build/test dependencies from Debian's packages (incl. Debian's own meshlab);
-#  - adds a deb-src entry (if none) and fetches MeshLab 2020.09's source package, whose headers
+#  - adds a deb-src entry (if none), derived from the machine's own apt sources, and fetches MeshLab 2020.09's source package, whose headers
 #    (src/common, vcglib) the plugin builds against, into $1 (default: build/deps).
 # Nothing of MeshLab or vcglib is ever committed: it lives in the (ignored) build tree.
 set -euo pipefail
@@ -19,14 +19,60 @@ for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 
-src_list=/etc/apt/sources.list.d/filter-vertex-brdf-src.sources
+# derive_deb_src APT_DIR CODENAME OUT_SOURCES OUT_LIST: deb-src entries made only from this
+# machine's own binary entries (APT_DIR/sources.list, APT_DIR/sources.list.d/*.list and *.sources)
+# whose suite is CODENAME or CODENAME-*: same URIs, suites, components and options, as deb-src.
+# deb822 stanzas go to OUT_SOURCES, one-line entries to OUT_LIST (each written only when
+# non-empty). No host name is ever written that the machine's sources do not already name.
+# Returns 1 when no entry could be derived.
+derive_deb_src() {
+  local apt=$1 cn=$2 out_sources=$3 out_list=$4 f stanzas lines
+  local -a sources=() lists=()
+  for f in "$apt"/sources.list.d/*.sources; do
+    [ -f "$f" ] && [ "$f" != "$out_sources" ] && sources+=("$f")
+  done
+  for f in "$apt"/sources.list "$apt"/sources.list.d/*.list; do
+    [ -f "$f" ] && [ "$f" != "$out_list" ] && lists+=("$f")
+  done
+  stanzas=""
+  if [ ${#sources[@]} -gt 0 ]; then
+    stanzas=$(awk -v cn="$cn" '
+      BEGIN { RS = "" }
+      {
+        n = split($0, L, "\n"); keep = 0
+        for (i = 1; i <= n; i++) if (L[i] ~ /^Suites:/) {
+          s = L[i]; sub(/^Suites:/, "", s); m = split(s, W, /[ \t]+/)
+          for (j = 1; j <= m; j++) if (W[j] == cn || index(W[j], cn "-") == 1) keep = 1
+        }
+        if (!keep) next
+        for (i = 1; i <= n; i++) print (L[i] ~ /^Types:/ ? "Types: deb-src" : L[i])
+        print ""
+      }' "${sources[@]}")
+  fi
+  lines=""
+  if [ ${#lists[@]} -gt 0 ]; then
+    lines=$(awk -v cn="$cn" '
+      $1 == "deb" {
+        i = 2
+        if ($2 ~ /^\[/) { while (i <= NF && $i !~ /\]$/) i++; i++ }
+        suite = $(i + 1)
+        if (suite == cn || index(suite, cn "-") == 1) { sub(/^[ \t]*deb[ \t]+/, "deb-src "); print }
+      }' "${lists[@]}")
+  fi
+  [ -n "$stanzas" ] && printf '%s\n' "$stanzas" > "$out_sources"
+  [ -n "$lines" ] && printf '%s\n' "$lines" > "$out_list"
+  [ -n "$stanzas$lines" ]
+}
+
 need_update=0
-if ! grep -rqs '^Types:.*deb-src\|^deb-src ' /etc/apt/sources.list /etc/apt/sources.list.d/; then
-  # Same URIs/suites as the binary entries, as deb-src.
-  if [ -f /etc/apt/sources.list.d/debian.sources ]; then
-    sed 's/^Types: deb$/Types: deb-src/' /etc/apt/sources.list.d/debian.sources > "$src_list"
-  else
-    echo "deb-src http://deb.debian.org/debian bookworm main" > /etc/apt/sources.list.d/filter-vertex-brdf-src.list
+if ! grep -qs '^Types:.*deb-src\|^deb-src ' /etc/apt/sources.list /etc/apt/sources.list.d/*.list \
+     /etc/apt/sources.list.d/*.sources; then
+  codename=$(. /etc/os-release && echo "${VERSION_CODENAME:-}")
+  if [ -z "$codename" ] || ! derive_deb_src /etc/apt "$codename" \
+       /etc/apt/sources.list.d/filter-vertex-brdf-src.sources /etc/apt/sources.list.d/filter-vertex-brdf-src.list; then
+    echo "setup: no deb-src entry, and none can be derived from this machine's apt sources for" \
+         "'${codename:-unknown release}'. Add a deb-src entry for your Debian mirror, then run again." >&2
+    exit 1
   fi
   need_update=1
 fi

@@ -8,4 +8,13 @@ bash "$ROOT/.ci/setup-debian.sh" "$ROOT/build/deps"
 cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHLAB_SOURCE_DIR="$ROOT/build/deps/meshlab"
 cmake --build "$BUILD" -j"$(nproc)"
 cd "$BUILD"
-ctest --output-on-failure -j"$(nproc)" "$@"
+rc=0
+ctest --output-on-failure -j"$(nproc)" "$@" || rc=$?
+# Tests that need the shared test data (not part of the repository) skip with the missing path.
+log=Testing/Temporary/LastTest.log
+if grep -qs "shared test data not found" "$log"; then
+  echo
+  echo "Skipped for lack of the shared test data (set VBRDF_SHARED_DIR to the folder holding scenes/ and real/):"
+  grep -o "shared test data not found: [^ ]*" "$log" | sed 's/^shared test data not found: /  missing /' | sort -u
+fi
+exit $rc

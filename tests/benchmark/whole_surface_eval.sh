@@ -1,13 +1,13 @@
 #!/bin/sh
 # Whole-surface relighting evaluation against per-pixel RTI baselines (issue 9, item 4).
-# For each scene of ../shared/scenes: fit the training project (16-bit linear photos, colour
+# For each scene of <shared>/scenes: fit the training project (16-bit linear photos, colour
 # correction off) with vbrdf_fit, then score the result on the held-out photos with vbrdf_eval
 # over the ground-truth-visible vertices, beside PTM and Relight-style RBF fitted per pixel on the
 # same training photos and scored on the same samples.
 #   tests/benchmark/whole_surface_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_eval OPTIONS...]
 #     BUILD_DIR  default build/release (holding tests/bench/vbrdf_fit and vbrdf_eval)
 #     WORK_DIR   default $BUILD_DIR/whole_surface_eval (fit results and logs)
-#   environment: VBRDF_SHARED   (default <repo>/../shared), SCENES (default the three below),
+#   environment: VBRDF_SHARED_DIR (default <repo>/../shared; VBRDF_SHARED is still read), SCENES (default the three below),
 #                VBRDF_FIT_OPTIONS (extra vbrdf_fit options, e.g. "--visibility cpu")
 #   e.g. extra options "--below-baselines" make a scene fail unless the product beats both baselines.
 # Skips (exit 0, with a message) when the shared scenes are absent (a plain clone has none).
@@ -17,13 +17,13 @@ repo=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-$repo/build/release}
 work=${2:-$build/whole_surface_eval}
 [ $# -ge 2 ] && shift 2 || shift $#
-shared=${VBRDF_SHARED:-$repo/../shared}
+shared=${VBRDF_SHARED_DIR:-${VBRDF_SHARED:-$repo/../shared}}
 scenes=${SCENES:-"spot_dir24 bunny_two_materials_dir32 teapot_dir16"}
 fit=$build/tests/bench/vbrdf_fit
 eval_tool=$build/tests/bench/vbrdf_eval
 
 if [ ! -d "$shared/scenes" ]; then
-  echo "SKIP: $shared/scenes not found (set VBRDF_SHARED to the folder holding scenes/)"
+  echo "SKIP: $shared/scenes not found (set VBRDF_SHARED_DIR to the folder holding scenes/)"
   exit 0
 fi
 for t in "$fit" "$eval_tool"; do

@@ -10,7 +10,9 @@
 // taken as orthographic (no intrinsics), with it the first raster's shot gives the camera and,
 // when --images is not given, the photos. `chart` fits the colour correction and prints the
 // patch CIEDE2000 before and after. `report` prints the accuracy figures of RESULTS.md;
-// `--check` makes it fail when a target is missed.
+// `--check` makes it fail when a target is missed. Its data folder is --shared, else the shared
+// test data (VBRDF_SHARED_DIR, tests/support/test_paths.h); when a set it needs is absent it
+// exits 77 (ctest's skip code) saying which.
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -18,6 +20,7 @@
 #include <iostream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include <opencv2/core.hpp>
 
@@ -27,6 +30,7 @@
 #include "light_file.h"
 #include "project.h"
 #include "sphere_lights.h"
+#include "test_paths.h"
 
 using namespace vbrdf;
 
@@ -34,7 +38,7 @@ namespace {
 
 struct Args {
   std::vector<std::string> images;
-  std::string project, out, lights, shared = VBRDF_SHARED_DIR, exposure = "auto";
+  std::string project, out, lights, shared = test::shared_dir(), exposure = "auto";
   std::vector<SphereCircle> spheres;
   std::vector<float> corners;
   int sphere_count = 1;
@@ -297,7 +301,22 @@ void report_scene_lights(const Args &a, Check &check) {
   }
 }
 
+// Exit status of `report` when its data is absent (ctest SKIP_RETURN_CODE).
+constexpr int kSkip = 77;
+
+// The folders `report` reads, relative to the shared data folder.
+const char *const kReportData[] = {"real/psm_uw_seitz", "real/harvard_psdata", "real/colorchecker", "scenes"};
+
 int run_report(const Args &a) {
+  bool missing = false;
+  for (const char *rel : kReportData)
+    if (access((a.shared + "/" + rel).c_str(), R_OK) != 0) {
+      std::printf("SKIP: shared test data not found: %s/%s (not part of the repository; set VBRDF_SHARED_DIR "
+                  "or --shared to the folder holding scenes/ and real/)\n",
+                  a.shared.c_str(), rel);
+      missing = true;
+    }
+  if (missing) return kSkip;
   Check check;
   std::printf("## vbrdf_calibrate report (shared data: %s)\n", a.shared.c_str());
   report_real_lights(a, check);

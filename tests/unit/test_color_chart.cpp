@@ -341,6 +341,7 @@ TEST(ChartCalibration, SamplesAreCorrectedPerPhoto) {
 }
 
 TEST(ChartRealPhotos, ColorCheckerClassicPhotosAreDetectedAndCorrected) {
+  VBRDF_REQUIRE_SHARED("real/colorchecker");
   const std::string d = test::shared_dir() + "/real/colorchecker/";
   const char *files[] = {"plantcv/classic.png", "plantcv/nano.jpeg", "mindvision_luimoli/d65_colorchecker.jpg"};
   for (const char *f : files) {
@@ -356,6 +357,7 @@ TEST(ChartRealPhotos, ColorCheckerClassicPhotosAreDetectedAndCorrected) {
 }
 
 TEST(ChartScenes, SpotColourCastIsRemoved) {
+  VBRDF_REQUIRE_SHARED("scenes/spot_dir24");
   const calib::SceneSet sc = calib::load_scene(test::shared_dir(), "spot_dir24");
   std::vector<cv::Mat> photos;
   for (const auto &p : sc.images) photos.push_back(linear_rgb_image(cv::imread(p, cv::IMREAD_UNCHANGED), true));

@@ -272,8 +272,8 @@ TEST(CoverageGeometry, SpecularLightIsTheMirrorOrItsPlaceableRotation) {
 
 // Sphere lights of the import filter on a scene with a mirror sphere (shared, read only).
 TEST(CoverageRun, SphereLightsOfNewPhotosMatchTheLightFile) {
+  VBRDF_REQUIRE_SHARED("scenes/spot_dir24/project.mlp");
   const std::string scene = test::shared_dir() + "/scenes/spot_dir24";
-  if (access((scene + "/project.mlp").c_str(), R_OK) != 0) GTEST_SKIP() << "no " << scene;
   const Project p = read_project(scene + "/project.mlp");
   const std::vector<LightEntry> truth = read_light_file(scene + "/lights.lp");
   std::vector<std::string> photos;

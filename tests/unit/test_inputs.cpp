@@ -126,8 +126,8 @@ TEST(Shot, CameraFrameDirectionsFollowRtiConvention) {
 }
 
 TEST(Project, ReadsSharedSceneLikeMeshLab) {
+  VBRDF_REQUIRE_SHARED("scenes/spot_dir24/project.mlp");
   const std::string mlp = test::shared_dir() + "/scenes/spot_dir24/project.mlp";
-  if (!file_exists(mlp)) GTEST_SKIP() << "shared scene not available: " << mlp;
   const Project p = read_project(mlp);
   EXPECT_TRUE(file_exists(p.mesh_path));
   ASSERT_EQ(p.rasters.size(), 24u);

@@ -402,7 +402,7 @@ TEST(SphereLights, LightFileRoundTrip) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[1].dir_cam[k], cal.photos[2].dir[k], 1e-6);
 }
 
-// ---- Real photographs with reference light directions (../shared/real) ----
+// ---- Real photographs with reference light directions (<shared>/real; skipped when absent) ----
 
 namespace {
 calib::Stats real_errors(const calib::RealLightSet &set, bool manual, LightCalibration *out = nullptr) {
@@ -420,6 +420,7 @@ calib::Stats real_errors(const calib::RealLightSet &set, bool manual, LightCalib
 } // namespace
 
 TEST(SphereRealSets, HarvardCatProbeWithTheSetsCircle) {
+  VBRDF_REQUIRE_SHARED("real/harvard_psdata/cat");
   const calib::RealLightSet set = calib::load_harvard_probe(test::shared_dir(), "cat", 1);
   const calib::Stats s = real_errors(set, true);
   EXPECT_EQ(s.n, 20u);
@@ -428,6 +429,7 @@ TEST(SphereRealSets, HarvardCatProbeWithTheSetsCircle) {
 }
 
 TEST(SphereRealSets, HarvardFrogProbeDetectedAutomatically) {
+  VBRDF_REQUIRE_SHARED("real/harvard_psdata/frog");
   const calib::RealLightSet set = calib::load_harvard_probe(test::shared_dir(), "frog", 2);
   LightCalibration cal;
   const calib::Stats s = real_errors(set, false, &cal);
@@ -442,6 +444,7 @@ TEST(SphereRealSets, HarvardFrogProbeDetectedAutomatically) {
 }
 
 TEST(SphereRealSets, PsmChromeDarkSphereIsFoundAndAgreesWithTheCourseReference) {
+  VBRDF_REQUIRE_SHARED("real/psm_uw_seitz");
   // The chrome sphere barely shows in a dark room; lights.txt is itself a coarse estimate
   // (integer-pixel highlights), see tests/calib/RESULTS.md.
   const calib::RealLightSet set = calib::load_psm_chrome(test::shared_dir());
@@ -457,6 +460,7 @@ TEST(SphereRealSets, PsmChromeDarkSphereIsFoundAndAgreesWithTheCourseReference) 
 }
 
 TEST(SphereScenes, SpotDarkSphereWithTheShotsCamera) {
+  VBRDF_REQUIRE_SHARED("scenes/spot_dir24");
   const calib::SceneSet sc = calib::load_scene(test::shared_dir(), "spot_dir24");
   std::vector<cv::Mat> photos;
   for (const auto &p : sc.images) photos.push_back(calib::read_image(p));
