@@ -1,6 +1,7 @@
 #include "pipeline.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -139,6 +140,7 @@ class GpuFitter : public PhongFitter {
 public:
   explicit GpuFitter(const GetProcAddressFn &get_proc) : gpu_(get_proc), name_("GPU compute shader, " + gpu_.device()) {}
   const char *name() const override { return name_.c_str(); }
+  std::string device() const { return gpu_.device(); }
   void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
     gpu_.fit_chunk(chunk, o, out);
   }
@@ -454,14 +456,46 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
 }
 } // namespace
 
+namespace {
+// True for GL implementations that rasterise on the CPU (Mesa llvmpipe/softpipe/swrast, lavapipe,
+// Microsoft's GDI renderer): there the compute shader runs on the same cores as the CPU fit, and
+// slower (tests/bench/FIT_PERFORMANCE.md: the CPU reference is 2.4-3.7x faster at the same error).
+bool software_renderer(const std::string &device) {
+  std::string d = device;
+  std::transform(d.begin(), d.end(), d.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  for (const char *name : {"llvmpipe", "softpipe", "swrast", "software rasterizer", "lavapipe", "gdi generic"})
+    if (d.find(name) != std::string::npos) return true;
+  return false;
+}
+
+class AutoCpuFitter : public PhongFitter {
+public:
+  explicit AutoCpuFitter(const std::string &device)
+      : name_("CPU (double, OpenMP); Auto chose it over the compute shader: the GL context is a software "
+              "renderer (" + device + ")") {}
+  const char *name() const override { return name_.c_str(); }
+  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
+    fit_chunk_cpu(chunk, o, out);
+  }
+
+private:
+  std::string name_;
+};
+} // namespace
+
 std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
                                                const std::function<void *(const char *)> &get_proc, const LogFn &log) {
   if (settings.fit_backend != FitBackendChoice::CPU) {
     if (get_proc) {
       try {
-        std::unique_ptr<PhongFitter> gpu(new GpuFitter(get_proc));
+        std::unique_ptr<GpuFitter> gpu(new GpuFitter(get_proc));
+        if (settings.fit_backend == FitBackendChoice::Auto && software_renderer(gpu->device())) {
+          std::unique_ptr<PhongFitter> cpu(new AutoCpuFitter(gpu->device()));
+          log(std::string("Phong fit: ") + cpu->name() + ". Set 'fitBackend' to GPU to use the shader anyway.");
+          return cpu;
+        }
         log(std::string("Phong fit: ") + gpu->name() + ".");
-        return gpu;
+        return std::unique_ptr<PhongFitter>(gpu.release());
       } catch (const ProcessingError &e) {
         if (settings.fit_backend == FitBackendChoice::GPU) throw;
         log(std::string("Phong fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");

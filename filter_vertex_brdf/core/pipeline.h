@@ -111,7 +111,9 @@ public:
 };
 
 // GPU when `get_proc` is given and the context has compute shaders (unless CPU is forced),
-// else CPU. Logs which one runs and why. The GL context must stay current while it is used.
+// else CPU. Auto also takes the CPU when the GL context is a software renderer (llvmpipe and
+// the like), where the shader is slower than the CPU reference; the fitter's name (in the report)
+// says so. Logs which one runs and why. The GL context must stay current while it is used.
 std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
                                                const std::function<void *(const char *)> &get_proc, const LogFn &log);
 

@@ -90,6 +90,9 @@ def cmd_fit(a):
     if failures:
         return report_failures(failures)
     print("\n".join(line for line in log.splitlines() if line.startswith("Vertex BRDF: ") and "%)" not in line))
+    for text in a.expect_log or []:
+        if text not in log:
+            failures.append(f"the log does not say '{text}'")
     for f in (out_ply, os.path.join(out_dir, "result_report.txt")):
         if not os.path.isfile(f):
             failures.append(f"missing output {f}")
@@ -317,6 +320,7 @@ def main(argv=None):
     fit.add_argument("--gt", required=True, help="ground-truth PLY with albedo_r/g/b")
     fit.add_argument("--photo-dir", help="use these photos (same file names) instead of the project's")
     fit.add_argument("--set", action="append", help="filter parameter name=value")
+    fit.add_argument("--expect-log", action="append", help="text the meshlabserver log must contain")
     fit.add_argument("--transformed", action="store_true",
                      help="run on a copy whose mesh carries a layer matrix (same world geometry)")
     fit.add_argument("--fit", choices=["scalar", "diag", "matrix"], default="scalar")
