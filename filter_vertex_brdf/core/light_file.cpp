@@ -125,7 +125,7 @@ std::string why_not_covering(const std::string &lp_path, const std::vector<Raste
   }
   for (const Raster &r : rasters)
     if (find_light_for_image(lights, r.image_path) < 0)
-      return "no entry for raster '" + r.label + "' (image '" + file_name_of(r.image_path) + "')";
+      return "has no entry for raster '" + r.label + "' (image '" + file_name_of(r.image_path) + "')";
   return "";
 }
 } // namespace

@@ -484,11 +484,15 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   std::vector<std::string> checked;
   result.light_file = settings.light_file.empty() ? find_default_light_file(input.rasters, input.project_path, &checked)
                                                   : settings.light_file;
+  if (result.light_file.empty() && checked.empty())
+    throw InputError("No light file (.lp) found beside the project or the photos: set 'lightFile' to the .lp "
+                     "that gives each photo's light direction.");
   if (result.light_file.empty()) {
     std::string why;
     for (const std::string &c : checked) why += "\n  " + c;
     throw InputError("No light file (.lp) beside the project or the photos has an entry for every raster: set "
-                     "'lightFile' to the .lp that gives each photo's light direction." + why);
+                     "'lightFile' to the .lp that gives each photo's light direction, or add the missing lines." +
+                     why);
   }
   const auto lights = resolve_light_directions(input.rasters, result.light_file);
   log("Lights: " + std::to_string(lights.size()) + " directions from '" + result.light_file + "'.");
