@@ -47,24 +47,6 @@ std::string strip_extension(const std::string &path) {
   return (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? path : path.substr(0, dot);
 }
 
-std::vector<std::string> lp_files_in(const std::string &dir) {
-  std::vector<std::string> found;
-  if (DIR *d = ::opendir(dir.c_str())) {
-    while (dirent *e = ::readdir(d)) {
-      const std::string n = e->d_name;
-      if (n.size() > 3 && to_lower(n.substr(n.size() - 3)) == ".lp") found.push_back(join_path(dir, n));
-    }
-    ::closedir(d);
-  }
-  return found;
-}
-
-double modification_time(const std::string &path) {
-  struct stat st;
-  if (::stat(path.c_str(), &st) != 0) return 0;
-  return double(st.st_mtim.tv_sec) + 1e-9 * double(st.st_mtim.tv_nsec);
-}
-
 float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // A mesh normal, normalised (file normals need not be unit length).
@@ -435,30 +417,6 @@ std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &
   return dirs;
 }
 
-std::string find_acquisition_light_file(const std::vector<Raster> &rasters, const std::string &project_path,
-                                        std::vector<std::string> *checked) {
-  std::vector<std::string> dirs;
-  if (!project_path.empty()) dirs.push_back(directory_of(project_path));
-  for (const Raster &r : rasters) dirs.push_back(directory_of(r.image_path));
-  std::vector<std::string> files;
-  std::set<std::string> seen_dirs;
-  for (const std::string &d : dirs)
-    if (seen_dirs.insert(d).second)
-      for (const std::string &f : lp_files_in(d)) files.push_back(f);
-  std::vector<std::pair<double, std::string>> by_time;
-  for (const std::string &f : files) by_time.emplace_back(-modification_time(f), f);
-  std::sort(by_time.begin(), by_time.end());
-  for (const auto &candidate : by_time) {
-    try {
-      lights_for_rasters(rasters, candidate.second);
-      return candidate.second;
-    } catch (const InputError &e) {
-      if (checked) checked->push_back(candidate.second + ": " + e.what());
-    }
-  }
-  return "";
-}
-
 LightSuggestion suggest_light_with_tolerance(const MeshView &mesh, const Shot &viewpoint, const uint8_t *visible,
                                              const float *needs, CoverageKind kind, const LightSuggestionSettings &s,
                                              float tolerance_deg, size_t *robust_covered, bool brute_force) {
@@ -760,7 +718,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   r.viewpoint = viewpoint_of_raster(r.viewpoints, chosen < 0 ? input.rasters.size() - 1 : size_t(chosen));
 
   std::vector<std::string> checked;
-  r.light_file = settings.light_file.empty() ? find_acquisition_light_file(input.rasters, input.project_path, &checked)
+  r.light_file = settings.light_file.empty() ? find_default_light_file(input.rasters, input.project_path, &checked)
                                              : settings.light_file;
   if (r.light_file.empty()) {
     std::string why;

@@ -45,13 +45,6 @@ size_t viewpoint_of_raster(const std::vector<Viewpoint> &viewpoints, size_t rast
 std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &rasters, const std::string &lp_path,
                                                      std::vector<std::string> *unused = nullptr);
 
-// Default light file of an acquisition: among the *.lp files beside the project and beside the
-// rasters' photos, the most recently modified one that has an entry for every raster (the
-// light-estimation tools rewrite it after each shot). Returns "" when none qualifies; `checked`
-// (optional) receives "<file>: <why not>" for each rejected candidate.
-std::string find_acquisition_light_file(const std::vector<Raster> &rasters, const std::string &project_path,
-                                        std::vector<std::string> *checked = nullptr);
-
 struct CoverageSettings {
   GatherSettings gather;            // T_s and T_d classify samples and drive the suggestions
   VisibilitySettings visibility;
@@ -70,7 +63,7 @@ struct CoverageSettings {
   // since, its recommended light counts as followed, i.e. as a light whose promises are checked
   // (suggest_light_learning), together with the lights followed before. Needs write_files.
   bool learn_from_previous = true;
-  std::string light_file;           // "" = find_acquisition_light_file
+  std::string light_file;           // "" = find_default_light_file (light_file.h)
   std::string suggestion_file;      // "" = <project folder>/<project name>_next_light.txt
   bool write_files = true;          // false: nothing is written (result only)
 };

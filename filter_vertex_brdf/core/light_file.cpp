@@ -4,7 +4,9 @@
 #include <cmath>
 #include <dirent.h>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <sys/stat.h>
 
 #include "errors.h"
 #include "file_util.h"
@@ -106,14 +108,44 @@ std::vector<std::string> lp_files_in(const std::string &dir) {
   std::sort(found.begin(), found.end());
   return found;
 }
+
+double modification_time(const std::string &path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) return 0;
+  return double(st.st_mtim.tv_sec) + 1e-9 * double(st.st_mtim.tv_nsec);
+}
+
+// "" when `lp_path` has an entry for every raster, else why not.
+std::string why_not_covering(const std::string &lp_path, const std::vector<Raster> &rasters) {
+  std::vector<LightEntry> lights;
+  try {
+    lights = read_light_file(lp_path);
+  } catch (const InputError &e) {
+    return e.what();
+  }
+  for (const Raster &r : rasters)
+    if (find_light_for_image(lights, r.image_path) < 0)
+      return "has no entry for raster '" + r.label + "' (image '" + file_name_of(r.image_path) + "')";
+  return "";
+}
 } // namespace
 
-std::string find_default_light_file(const std::string &project_path, const std::string &first_image_path) {
-  for (const std::string &dir : {project_path.empty() ? std::string() : directory_of(project_path),
-                                 first_image_path.empty() ? std::string() : directory_of(first_image_path)}) {
-    if (dir.empty()) continue;
-    const auto found = lp_files_in(dir);
-    if (!found.empty()) return found.front();
+std::string find_default_light_file(const std::vector<Raster> &rasters, const std::string &project_path,
+                                    std::vector<std::string> *checked) {
+  std::vector<std::string> dirs;
+  if (!project_path.empty()) dirs.push_back(directory_of(project_path));
+  for (const Raster &r : rasters) dirs.push_back(directory_of(r.image_path));
+  std::vector<std::pair<double, std::string>> candidates;  // (-time, path): newest first, then path order
+  std::set<std::string> seen_dirs, seen_files;
+  for (const std::string &d : dirs)
+    if (seen_dirs.insert(d).second)
+      for (const std::string &f : lp_files_in(d))
+        if (seen_files.insert(f).second) candidates.emplace_back(-modification_time(f), f);
+  std::sort(candidates.begin(), candidates.end());
+  for (const auto &candidate : candidates) {
+    const std::string why = why_not_covering(candidate.second, rasters);
+    if (why.empty()) return candidate.second;
+    if (checked) checked->push_back(candidate.second + ": " + why);
   }
   return "";
 }

@@ -11,6 +11,7 @@
 #include "light_file.h"
 #include "output_ply.h"
 #include "phong_fit_gpu.h"
+#include "result_schema.h"
 #include "visibility_gl.h"
 
 namespace vbrdf {
@@ -347,29 +348,22 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
   const size_t n = input.mesh.vertex_count;
   r.colors_rgba.assign(4 * n, 0);
   r.quality.assign(n, 0.0f);
-  std::vector<std::string> names = {"diffuse_r", "diffuse_g", "diffuse_b", "n_visible", "n_diffuse", "n_specular", "coloured"};
-  if (!r.fits.empty())
-    for (const char *name : {"kd", "ks", "shininess", "color_r", "color_g", "color_b", "dq", "sq", "fit_rmse",
-                             "fit_status", "fit_iterations"})
-      names.push_back(name);
-  for (const std::string &name : names) r.attributes.push_back({name, std::vector<float>(n, 0.0f)});
-  auto attr = [&r](size_t i) -> std::vector<float> & { return r.attributes[i].values; };
+  std::vector<VertexRecord> records(n);
   for (size_t v = 0; v < n; ++v) {
     const DiffuseEstimate &e = r.diffuse[v];
+    VertexRecord &rec = records[v];
     float rho[3];
     const bool coloured = displayed_reflectance(r, v, rho);
-    for (int c = 0; c < 3; ++c) attr(size_t(c))[v] = rho[c];
-    attr(3)[v] = e.n_seen, attr(4)[v] = e.n_diffuse, attr(5)[v] = e.n_specular;
+    for (int c = 0; c < 3; ++c) rec.diffuse[c] = rho[c];
+    rec.n_visible = e.n_seen, rec.n_diffuse = e.n_diffuse, rec.n_specular = e.n_specular;
     // coloured = 2: the colour comes only from pixels at a silhouette or contact (own-surface texels
     // of a straddling footprint, or mixed pixels): lower confidence than clean pixels.
     const bool mixed = e.from_mixed_pixels || e.from_rim_pixels;
     const bool from_neighbours = !r.fits.empty() && r.fits[v].status == kFitFromNeighbours;
-    attr(6)[v] = coloured ? (from_neighbours ? 3.0f : mixed ? 2.0f : 1.0f) : 0.0f;
+    rec.coloured = coloured ? (from_neighbours ? 3.0f : mixed ? 2.0f : 1.0f) : 0.0f;
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
-      const float values[] = {f.kd, f.ks, f.shininess, f.color[0], f.color[1], f.color[2], f.dq, f.sq, f.rmse,
-                              float(f.status), float(f.iterations)};
-      for (size_t k = 0; k < 11; ++k) attr(7 + k)[v] = values[k];
+      rec.fit = f;
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -387,6 +381,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       if (e.n_seen == 0) ++r.vertices_unseen; else ++r.vertices_no_diffuse;
     }
   }
+  r.attributes = result_attributes(records, !r.fits.empty());  // by name, in the schema's file order
 }
 
 std::string build_report(const FitInput &input, const FitSettings &settings, const FitResult &r) {
@@ -520,12 +515,19 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   result.visibility_backend = visibility.name();
   result.fit_backend = settings.fit_reflectance ? fitter->name() : "";
 
-  result.light_file = settings.light_file.empty()
-                          ? find_default_light_file(input.project_path, input.rasters.front().image_path)
-                          : settings.light_file;
-  if (result.light_file.empty())
-    throw InputError("No light file (.lp) found beside the project or the images: set 'lightFile' to the .lp "
+  std::vector<std::string> checked;
+  result.light_file = settings.light_file.empty() ? find_default_light_file(input.rasters, input.project_path, &checked)
+                                                  : settings.light_file;
+  if (result.light_file.empty() && checked.empty())
+    throw InputError("No light file (.lp) found beside the project or the photos: set 'lightFile' to the .lp "
                      "that gives each photo's light direction.");
+  if (result.light_file.empty()) {
+    std::string why;
+    for (const std::string &c : checked) why += "\n  " + c;
+    throw InputError("No light file (.lp) beside the project or the photos has an entry for every raster: set "
+                     "'lightFile' to the .lp that gives each photo's light direction, or add the missing lines." +
+                     why);
+  }
   const auto lights = resolve_light_directions(input.rasters, result.light_file);
   log("Lights: " + std::to_string(lights.size()) + " directions from '" + result.light_file + "'.");
 

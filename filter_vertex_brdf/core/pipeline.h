@@ -42,7 +42,7 @@ struct FitSettings {
   // viewpoint; 8 per viewpoint = one group each, viewpoints in order of their first raster.
   std::vector<float> chart_corners;
   ExposureMode exposure = ExposureMode::Auto;  // per-photo normalisation by the chart's neutrals
-  std::string light_file;   // "" = search beside the project, then beside the images
+  std::string light_file;   // "" = find_default_light_file (light_file.h)
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
   // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "errors.h"
+#include "result_schema.h"
 
 namespace vbrdf {
 
@@ -114,24 +115,12 @@ ResultPly read_result_ply(const std::string &path) {
 }
 
 std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path) {
-  const char *names[] = {"kd", "ks", "shininess", "color_r", "color_g", "color_b", "dq", "sq", "fit_rmse", "fit_status"};
-  std::vector<const std::vector<float> *> columns;
-  for (const char *name : names) {
-    const auto it = result.vertex_properties.find(name);
-    if (it == result.vertex_properties.end())
-      throw InputError("Result '" + path + "' has no per-vertex '" + name +
-                       "': run the fit with 'Fit Phong reflectance' on first.");
-    columns.push_back(&it->second);
-  }
-  std::vector<VertexFit> fits(columns[0]->size());
-  for (size_t v = 0; v < fits.size(); ++v) {
-    VertexFit &f = fits[v];
-    f.kd = (*columns[0])[v], f.ks = (*columns[1])[v], f.shininess = (*columns[2])[v];
-    for (int c = 0; c < 3; ++c) f.color[c] = (*columns[3 + size_t(c)])[v];
-    f.dq = (*columns[6])[v], f.sq = (*columns[7])[v], f.rmse = (*columns[8])[v];
-    f.status = uint8_t((*columns[9])[v]);
-    f.iterations = 0, f.converged = 0;
-  }
+  const std::string missing = first_missing_model_attribute(result.vertex_properties);
+  if (!missing.empty())
+    throw InputError("Result '" + path + "' has no per-vertex '" + missing +
+                     "': run the fit with 'Fit Phong reflectance' on first.");
+  std::vector<VertexFit> fits;
+  for (const VertexRecord &record : records_from_columns(result.vertex_properties, path)) fits.push_back(record.fit);
   return fits;
 }
 

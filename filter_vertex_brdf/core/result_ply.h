@@ -21,8 +21,10 @@ struct ResultPly {
 // truncated.
 ResultPly read_result_ply(const std::string &path);
 
-// Per-vertex fits from the properties kd, ks, shininess, color_r/g/b, dq, sq, fit_rmse and
-// fit_status. Throws InputError naming the first missing property.
+// Per-vertex fits from the properties named in the result schema (result_schema.h), by name:
+// every Phong attribute present is read (dq, sq, fit_rmse and fit_iterations may be absent: 0).
+// Throws InputError naming the first missing attribute needed for the model (kd, ks, shininess,
+// color_r/g/b, fit_status), or a column of the wrong length.
 std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path);
 
 } // namespace vbrdf

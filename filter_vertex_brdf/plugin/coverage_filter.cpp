@@ -89,7 +89,8 @@ void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &par
       kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
       "RTI light file with one line per photo (image file name and unit direction towards the light in the "
       "camera frame). Entries for photos not imported yet are ignored. Empty: the most recently modified "
-      "*.lp beside the project or the photos that has an entry for every raster."));
+      "*.lp beside the project or the photos that has an entry for every raster (the rule of every Vertex "
+      "BRDF filter)."));
   params.addParam(RichSaveFile(
       kSuggestionFile, "", "Text (*.txt)", "Suggestion file",
       "Where the suggestions are written (key: value lines, then the report); the vertices only a new "

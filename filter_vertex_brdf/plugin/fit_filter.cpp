@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/result_schema.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
@@ -86,8 +87,8 @@ QString FitFilter::info() const {
          "with too little specular evidence get a diffuse-only fit (k<sub>s</sub> = 0).<br><br>"
          "Results: vertex colours become the fitted albedo (sRGB; vertices no photo sees keep their "
          "colour), vertex quality the chosen fit quality, the per-vertex values are stored as float "
-         "attributes (kd, ks, shininess, color_r/g/b, dq, sq, fit_rmse, diffuse_r/g/b = k<sub>d</sub> C, "
-         "n_visible, n_diffuse, n_specular, coloured, ...) and written with the geometry to a PLY, plus a text "
+         "attributes (" + QString::fromStdString(vbrdf::result_attribute_names()) + "; diffuse_r/g/b = "
+         "k<sub>d</sub> C) and written with the geometry to a PLY, plus a text "
          "report beside it. The mesh geometry is not changed. The mesh needs per-vertex normals; photos "
          "must be undistorted.<br><br>"
          "Colour correction: when a 24-patch ColorChecker is in the photos of a viewpoint (detected, or "
@@ -114,7 +115,8 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
       kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
       "RTI light file: first line the number of photos, then one line per photo: image file name and the "
       "unit direction towards the light (x right, y up, z towards the camera). Photos are matched by file "
-      "name. Empty: the first *.lp beside the project, else beside the first photo."));
+      "name. Empty: the most recently modified *.lp beside the project or the photos that has an entry for "
+      "every photo (the rule of every Vertex BRDF filter)."));
   params.addParam(RichSaveFile(
       kOutputPly, "", "PLY (*.ply)", "Output PLY",
       "Where the mesh with the per-vertex results is written (binary PLY with float properties), with a "

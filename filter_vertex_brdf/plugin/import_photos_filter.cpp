@@ -107,7 +107,7 @@ std::string lights_from_sphere(const RichParameterList &params, const std::vecto
                                const std::string &project, const std::function<void(const std::string &)> &log) {
   const vbrdf::Raster &reference = rasters[reference_index];
   const std::string given = resolve_path(utf8(params.getOpenFileName(kLightFile)), project);
-  const std::string existing_lp = given.empty() ? vbrdf::find_acquisition_light_file(rasters, project) : given;
+  const std::string existing_lp = given.empty() ? vbrdf::find_default_light_file(rasters, project) : given;
   std::vector<vbrdf::LightEntry> existing;
   if (!existing_lp.empty()) existing = vbrdf::read_light_file(existing_lp);
   std::string out = resolve_path(utf8(params.getSaveFileName(kOutputLightFile)), project);
@@ -134,7 +134,8 @@ std::string lights_from_sphere(const RichParameterList &params, const std::vecto
   return out;
 }
 
-// .lp mode: the given .lp, or the newest one beside the project or photos that has every raster.
+// .lp mode: the given .lp, or the default one (find_default_light_file: the newest one beside the
+// project or photos that has an entry for every raster, the new photos included).
 std::string lights_from_file(const RichParameterList &params, const std::vector<vbrdf::Raster> &all,
                              const std::vector<vbrdf::Raster> &added, const std::string &project) {
   const std::string given = resolve_path(utf8(params.getOpenFileName(kLightFile)), project);
@@ -143,13 +144,16 @@ std::string lights_from_file(const RichParameterList &params, const std::vector<
     return given;
   }
   std::vector<std::string> checked;
-  const std::string found = vbrdf::find_acquisition_light_file(all, project, &checked);
+  const std::string found = vbrdf::find_default_light_file(all, project, &checked);
   if (found.empty()) {
+    std::string why;
+    for (const std::string &c : checked) why += "\n  " + c;
     std::string names;
     for (const vbrdf::Raster &r : added) names += (names.empty() ? "" : ", ") + r.label;
     throw vbrdf::InputError("No light file (.lp) beside the project or the photos has an entry for every raster "
-                            "including the new photos (" + names + "): add their lights to the .lp (e.g. with "
-                            "vbrdf_calibrate lights), set 'lightFile', or choose 'Reflective sphere'.");
+                            "including the new photos (" + names + "): add their lights to the .lp (e.g. with \"Vertex BRDF: "
+                            "estimate light directions from a reflective sphere\"), set 'lightFile', or choose "
+                            "'Reflective sphere'." + why);
   }
   return found;
 }
@@ -168,8 +172,8 @@ QString ImportPhotosFilter::info() const {
          "Lights: from an <i>.lp</i> file that has an entry for every photo, or estimated from the reflective "
          "sphere visible in the photos (located on all photos of the viewpoint, or given by centre and radius "
          "in pixels); the estimated lights are written, with every entry of the existing .lp, to a new .lp "
-         "beside the project, which the coverage and fit filters then find by themselves (the newest .lp that "
-         "covers every raster). Save the project (File &gt; Save Project) to keep the new rasters.";
+         "beside the project, which the fit, coverage and relight filters then find by themselves (each takes "
+         "the most recently modified .lp beside the project or the photos that has an entry for every raster). Save the project (File &gt; Save Project) to keep the new rasters.";
 }
 
 MeshFilterInterface::FilterClass ImportPhotosFilter::filterClass() const {

@@ -15,6 +15,7 @@
 #include "core/project.h"
 #include "core/relight_render.h"
 #include "core/result_ply.h"
+#include "core/result_schema.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
@@ -112,27 +113,24 @@ Settings settings_from(const RichParameterList &params) {
   return s;
 }
 
-// The fit filter's per-vertex float attributes, in array order.
+// The fit filter's per-vertex float attributes, read by name through the result schema.
 std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays) {
   using Alloc = vcg::tri::Allocator<CMeshO>;
-  const char *names[] = {"kd", "ks", "shininess", "color_r", "color_g", "color_b", "fit_status"};
-  std::vector<CMeshO::PerVertexAttributeHandle<float>> handles;
-  for (const char *name : names) {
-    auto h = Alloc::FindPerVertexAttribute<float>(mesh.cm, name);
-    if (!Alloc::IsValidHandle(mesh.cm, h))
-      throw vbrdf::InputError("Mesh '" + utf8(mesh.label()) + "' has no per-vertex '" + name +
-                              "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit Phong reflectance' on) "
-                              "first, or set 'fitResultPly' to the PLY it wrote.");
-    handles.push_back(h);
+  vbrdf::ResultColumns columns;
+  for (const vbrdf::ResultAttribute &a : vbrdf::result_schema()) {
+    auto h = Alloc::FindPerVertexAttribute<float>(mesh.cm, a.name);
+    if (!Alloc::IsValidHandle(mesh.cm, h)) continue;
+    std::vector<float> &column = columns[a.name];
+    for (size_t v : arrays.vertex_index) column.push_back(h[v]);
   }
-  std::vector<vbrdf::VertexFit> fits(arrays.vertex_index.size());
-  for (size_t i = 0; i < fits.size(); ++i) {
-    const size_t v = arrays.vertex_index[i];
-    vbrdf::VertexFit &f = fits[i];
-    f.kd = handles[0][v], f.ks = handles[1][v], f.shininess = handles[2][v];
-    for (int c = 0; c < 3; ++c) f.color[c] = handles[3 + size_t(c)][v];
-    f.status = uint8_t(std::max(0.0f, std::min(2.0f, handles[6][v])));
-  }
+  const std::string missing = vbrdf::first_missing_model_attribute(columns);
+  if (!missing.empty())
+    throw vbrdf::InputError("Mesh '" + utf8(mesh.label()) + "' has no per-vertex '" + missing +
+                            "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit Phong reflectance' on) "
+                            "first, or set 'fitResultPly' to the PLY it wrote.");
+  std::vector<vbrdf::VertexFit> fits;
+  for (const vbrdf::VertexRecord &record : vbrdf::records_from_columns(columns, utf8(mesh.label())))
+    fits.push_back(record.fit);
   return fits;
 }
 
@@ -167,9 +165,8 @@ RasterSet rasters_to_render(const MeshDocument &document, const MeshModel &mesh,
   if (set.rasters.empty())
     throw vbrdf::InputError("No raster to render: open the project with its photos, or set 'rasterProject' to an "
                             ".mlp (e.g. the held-out photos' heldout/project.mlp).");
-  set.light_file = s.light_file.empty()
-                       ? vbrdf::find_default_light_file(set.project, set.rasters.front().image_path)
-                       : resolve_path(s.light_file, project_path(document, mesh));
+  set.light_file = s.light_file.empty() ? vbrdf::find_default_light_file(set.rasters, set.project)
+                                        : resolve_path(s.light_file, project_path(document, mesh));
   return set;
 }
 
@@ -270,8 +267,8 @@ void RelightFilter::initParameters(const MeshDocument &, RichParameterList &para
                                "Its mesh is ignored; its cameras must be registered to the current mesh."));
   params.addParam(RichOpenFile(kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
                                "Light direction of each rendered raster (RTI .lp, matched by image file name). "
-                               "Empty: the first *.lp beside the project (or the raster project), else beside its "
-                               "first photo."));
+                               "Empty: the most recently modified *.lp beside the project (or the raster project) or "
+                               "the rendered photos that has an entry for every one of them."));
   params.addParam(RichString(kOutputFolder, "", "Output folder",
                              "Where the images, contact_sheet.png and relight_table.csv are written (created if "
                              "needed; existing files of the same names are replaced). Relative paths are relative "
@@ -338,8 +335,9 @@ void RelightFilter::apply(FilterRun &run) const {
   std::vector<std::array<float, 3>> lights;
   if (s.render_rasters) {
     if (set.light_file.empty())
-      throw vbrdf::InputError("No light file (.lp) found beside '" + set.project +
-                              "' or its photos: set 'lightFile' to the .lp of the rendered rasters.");
+      throw vbrdf::InputError("No light file (.lp) beside '" + set.project +
+                              "' or its photos has an entry for every rendered raster: set 'lightFile' to the .lp "
+                              "of the rendered rasters.");
     lights = vbrdf::resolve_light_directions(set.rasters, set.light_file);
   }
 

@@ -46,7 +46,7 @@ int main(int argc, char **argv) {
   }
   const Project project = read_project(argv[1]);
   const MeshData mesh = load_mesh_ply(project.mesh_path);
-  const auto all_lights = resolve_light_directions(project.rasters, find_default_light_file(project.project_path, ""));
+  const auto all_lights = resolve_light_directions(project.rasters, find_default_light_file(project.rasters, project.project_path));
   if (photo_counts.empty()) photo_counts.push_back(int(project.rasters.size()));
   test::OsMesaContext context;
   if (header) std::printf("backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples\n");

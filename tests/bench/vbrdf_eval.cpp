@@ -57,7 +57,7 @@ struct Photos {
 Photos load_photos(const std::string &mlp, std::string lp, const std::string &photo_dir) {
   Photos p{read_project(mlp), {}};
   if (p.project.rasters.empty()) throw InputError(mlp + " has no raster");
-  if (lp.empty()) lp = find_default_light_file(p.project.project_path, p.project.rasters.front().image_path);
+  if (lp.empty()) lp = find_default_light_file(p.project.rasters, p.project.project_path);
   p.lights = resolve_light_directions(p.project.rasters, lp);
   if (!photo_dir.empty())
     for (Raster &r : p.project.rasters) r.image_path = join_path(photo_dir, file_name_of(r.image_path));

@@ -126,7 +126,7 @@ void use_photo_dir(std::vector<Raster> &rasters, const std::string &dir) {
 }
 
 std::string default_lp(const Project &p) {
-  const std::string lp = find_default_light_file(p.project_path, p.rasters.front().image_path);
+  const std::string lp = find_default_light_file(p.rasters, p.project_path);
   if (lp.empty()) throw InputError("no .lp beside " + p.project_path + ": pass --lp");
   return lp;
 }

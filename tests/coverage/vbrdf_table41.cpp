@@ -86,7 +86,7 @@ void load_candidates(const Options &o, MeshData &mesh, std::vector<Raster> &rast
     if (i == 0) mesh = load_mesh_ply(p.mesh_path);
     else if (load_mesh_ply(p.mesh_path).positions.size() != mesh.positions.size())
       throw InputError("Project '" + o.projects[i] + "' has another mesh than '" + o.projects[0] + "'.");
-    const std::string lp = find_acquisition_light_file(p.rasters, p.project_path);
+    const std::string lp = find_default_light_file(p.rasters, p.project_path);
     if (lp.empty()) throw InputError("No .lp beside '" + o.projects[i] + "' has an entry for each of its rasters.");
     const auto l = lights_for_rasters(p.rasters, lp);
     rasters.insert(rasters.end(), p.rasters.begin(), p.rasters.end());

@@ -172,7 +172,7 @@ TEST(AcquisitionSim, StallsWhenNoSuggestionCanReachTheRest) {
 TEST(AcquisitionSim, GatheredCandidatesMatchTheCoverageCounts) {
   const Project p = read_project(test::source_dir() + "/sample_projects/synth_basic/project.mlp");
   const MeshData mesh = load_mesh_ply(p.mesh_path);
-  const auto lights = lights_for_rasters(p.rasters, find_acquisition_light_file(p.rasters, p.project_path));
+  const auto lights = lights_for_rasters(p.rasters, find_default_light_file(p.rasters, p.project_path));
   auto vis = make_cpu_visibility(mesh.view(), VisibilitySettings());
   const CandidateSet set = gather_candidates(mesh.view(), p.rasters, lights, *vis, GatherSettings());
   ASSERT_EQ(set.size(), 16u);
@@ -203,7 +203,7 @@ TEST(AcquisitionSim, GatheredCandidatesMatchTheCoverageCounts) {
   const Project two = read_project(test::source_dir() + "/sample_projects/synth_two_views/project.mlp");
   const MeshData mesh2 = load_mesh_ply(two.mesh_path);
   auto vis2 = make_cpu_visibility(mesh2.view(), VisibilitySettings());
-  const auto lights2 = lights_for_rasters(two.rasters, find_acquisition_light_file(two.rasters, two.project_path));
+  const auto lights2 = lights_for_rasters(two.rasters, find_default_light_file(two.rasters, two.project_path));
   try {
     gather_candidates(mesh2.view(), two.rasters, lights2, *vis2, GatherSettings());
     ADD_FAILURE() << "two viewpoints accepted";

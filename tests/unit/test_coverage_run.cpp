@@ -12,6 +12,7 @@
 #include "errors.h"
 #include "light_file.h"
 #include "mesh_io.h"
+#include "pipeline.h"
 #include "project.h"
 #include "test_paths.h"
 #include "test_scenes.h"
@@ -128,7 +129,7 @@ TEST(CoverageRun, LightLookupAllowsPhotosNotImportedYet) {
   EXPECT_NE(msg.find("'p9'"), std::string::npos);
 }
 
-TEST(CoverageRun, AcquisitionLightFileIsTheNewestCompleteOne) {
+TEST(LightFile, DefaultIsTheNewestCompleteOne) {
   const std::string dir = test::scratch_dir("cov_find");
   const Shot shot = front_camera();
   const std::vector<Raster> rasters = {raster_at("p0", dir + "/p0.png", shot), raster_at("p1", dir + "/p1.png", shot)};
@@ -137,14 +138,52 @@ TEST(CoverageRun, AcquisitionLightFileIsTheNewestCompleteOne) {
   ::usleep(20000);
   write_text(dir + "/new.lp", "3\np0.png 0 0 1\np1.png 1 0 1\np2.png 0 1 1\n");
   std::vector<std::string> checked;
-  EXPECT_EQ(find_acquisition_light_file(rasters, dir + "/project.mlp", &checked), dir + "/new.lp");
+  EXPECT_EQ(find_default_light_file(rasters, dir + "/project.mlp", &checked), dir + "/new.lp");
   ::usleep(20000);  // file times are as coarse as the kernel's tick
   write_text(dir + "/partial.lp", "1\np0.png 0 0 1\n");  // now the newest, but incomplete
   checked.clear();
-  EXPECT_EQ(find_acquisition_light_file(rasters, dir + "/project.mlp", &checked), dir + "/new.lp");
+  EXPECT_EQ(find_default_light_file(rasters, dir + "/project.mlp", &checked), dir + "/new.lp");
   ASSERT_EQ(checked.size(), 1u);
   EXPECT_NE(checked[0].find("partial.lp"), std::string::npos);
-  EXPECT_EQ(find_acquisition_light_file({raster_at("x", dir + "/x.png", shot)}, dir + "/project.mlp"), "");
+  EXPECT_EQ(find_default_light_file({raster_at("x", dir + "/x.png", shot)}, dir + "/project.mlp"), "");
+}
+
+TEST(LightFile, EveryFilterPicksTheSameFileBesideAStaleLightsLp) {
+  // An acquisition after an import: the first lights.lp (complete but superseded), the import's
+  // newer <project>_lights.lp, and a still newer .lp that lacks a raster. The fit (which took the
+  // alphabetically first, lights.lp, before issue 10), coverage and the shared rule agree on the
+  // newer complete file. Relight, import and the tools call the same find_default_light_file.
+  const SampleProject sample;
+  const std::string dir = test::scratch_dir("lp_policy"), project = dir + "/project.mlp";
+  const std::string lights = read_text(sample.project.project_path.substr(0, sample.project.project_path.rfind('/')) +
+                                       "/lights.lp");
+  write_text(dir + "/lights.lp", lights);
+  ::usleep(20000);  // file times are as coarse as the kernel's tick
+  write_text(dir + "/project_lights.lp", lights);
+  ::usleep(20000);
+  write_text(dir + "/partial.lp", "1\nimages/light_000.png 0 0 1\n");
+  const std::string expected = dir + "/project_lights.lp";
+  const std::vector<Raster> &rasters = sample.project.rasters;
+  std::vector<std::string> checked;
+  EXPECT_EQ(find_default_light_file(rasters, project, &checked), expected);
+  ASSERT_EQ(checked.size(), 1u);
+  EXPECT_NE(checked[0].find("partial.lp"), std::string::npos);
+
+  CoverageInput cin = sample.input(rasters);
+  cin.project_path = project;
+  EXPECT_EQ(run_on(cin, CoverageSettings(), dir).light_file, expected);
+
+  FitInput fin;
+  fin.mesh = sample.mesh.view();
+  fin.mesh_name = "synth_basic";
+  fin.rasters = rasters;
+  fin.project_path = project;
+  FitSettings fs;
+  fs.fit_reflectance = false;
+  fs.output_ply = dir + "/fit.ply";
+  auto vis = make_cpu_visibility(fin.mesh, fs.visibility);
+  const FitResult fit = run_fit(fin, fs, *vis, nullptr, {}, [](const std::string &) {});
+  EXPECT_EQ(fit.light_file, expected);
 }
 
 TEST(CoverageRun, NewPhotosAndMergedLights) {

@@ -66,7 +66,12 @@ TEST(LightFile, RoundTripAndMatchingByFileName) {
   EXPECT_EQ(find_light_for_image(back, "/abs/path/to/L_001.png"), 1);
   EXPECT_EQ(find_light_for_image(back, "/x/l_000.PNG"), 0);  // case-insensitive fallback
   EXPECT_EQ(find_light_for_image(back, "/x/other.png"), -1);
-  EXPECT_EQ(find_default_light_file(dir + "/project.mlp", ""), dir + "/out.lp");
+  Raster a, b;
+  a.label = "a", a.image_path = "/elsewhere/images/L_000.png";
+  b.label = "b", b.image_path = "/elsewhere/images/L_001.png";
+  EXPECT_EQ(find_default_light_file({a, b}, dir + "/project.mlp"), dir + "/out.lp");
+  b.image_path = "/elsewhere/images/L_002.png";  // no entry for it: the file does not qualify
+  EXPECT_EQ(find_default_light_file({a, b}, dir + "/project.mlp"), "");
 }
 
 TEST(Shot, PixelOriginIsTopLeftWithYDown) {
