@@ -100,32 +100,43 @@ NeighbourFillStats fill_from_neighbours(const MeshView &mesh, const uint8_t *see
   const float min_length = 1e-6f * std::max(compute_bounds(mesh).diagonal(), 1e-30f);
   std::vector<uint32_t> front;
   std::vector<VertexFit> filled;
-  for (int ring = 1;; ++ring) {
-    front.clear();
-    for (size_t v = 0; v < n; ++v) {
-      if (model[v] || (!seen[v] && ring > unseen_rings)) continue;
-      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
-        if (model[adj.neighbours[k]]) {
-          front.push_back(uint32_t(v));
-          break;
-        }
-    }
-    if (front.empty()) break;
+  // Ring 1: every eligible vertex next to a modelled one; later rings: the eligible neighbours of
+  // the vertices the previous ring filled (so the walk costs O(edges), not O(rings x vertices)).
+  const auto eligible = [&](uint32_t v, int ring) { return !model[v] && (seen[v] || ring <= unseen_rings); };
+  std::vector<uint8_t> queued(n, 0);
+  for (size_t v = 0; v < n; ++v) {
+    if (!eligible(uint32_t(v), 1)) continue;
+    for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
+      if (model[adj.neighbours[k]]) {
+        front.push_back(uint32_t(v));
+        queued[v] = 1;
+        break;
+      }
+  }
+  for (int ring = 1; !front.empty(); ++ring) {
     stats.rings = ring;
     filled.assign(front.size(), VertexFit());
     std::vector<uint8_t> ok(front.size(), 0);
 #pragma omp parallel for schedule(static)
     for (long long i = 0; i < (long long)front.size(); ++i)
       ok[size_t(i)] = average_of_neighbours(mesh, adj, model, fits, front[size_t(i)], min_length, filled[size_t(i)]);
-    size_t committed = 0;
+    std::vector<uint32_t> next;
     for (size_t i = 0; i < front.size(); ++i) {  // commit after the pass: order-independent
-      if (!ok[i]) continue;
-      ++committed;
+      queued[front[i]] = 0;
+      if (!ok[i]) continue;  // no usable weight: left for a later ring's neighbours to retry
       fits[front[i]] = filled[i];
       model[front[i]] = 1;
       ++(seen[front[i]] ? stats.filled_seen : stats.filled_unseen);
     }
-    if (committed == 0) break;  // nothing could be averaged (no usable weight): stop, never loop
+    for (size_t i = 0; i < front.size(); ++i) {
+      if (!ok[i]) continue;
+      const uint32_t v = front[i];
+      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k) {
+        const uint32_t u = adj.neighbours[k];
+        if (!queued[u] && eligible(u, ring + 1)) queued[u] = 1, next.push_back(u);
+      }
+    }
+    front.swap(next);
   }
   // Seen vertices in parts of the mesh without any modelled vertex (a small separate piece whose
   // samples are all shadowed or clipped): the nearest modelled vertex in space (vcglib kd-tree).
