@@ -25,6 +25,25 @@ bool is_identity(const Matrix44m &m) {
 
 std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
 
+// The vertex colours the mesh had before any of our filters painted it (fit albedo, coverage
+// classes): saved once, at the first paint, so that "keep the input colour" keeps the user's
+// colours, not the previous run's.
+const char *const kInputColorAttribute = "vbrdf_input_color";
+using ColorAlloc = vcg::tri::Allocator<CMeshO>;
+
+bool has_input_colors(const CMeshO &cm) {
+  CMeshO &m = const_cast<CMeshO &>(cm);  // vcglib's attribute lookup is not const
+  return ColorAlloc::IsValidHandle(m, ColorAlloc::FindPerVertexAttribute<vcg::Color4b>(m, kInputColorAttribute));
+}
+
+void save_input_colors_once(CMeshO &cm) {
+  if (has_input_colors(cm)) return;
+  if (vcg::tri::HasPerVertexAttribute(cm, kInputColorAttribute))  // same name, other type
+    ColorAlloc::DeletePerVertexAttribute(cm, kInputColorAttribute);
+  auto saved = ColorAlloc::GetPerVertexAttribute<vcg::Color4b>(cm, kInputColorAttribute);
+  for (size_t i = 0; i < cm.vert.size(); ++i) saved[i] = cm.vert[i].cC();
+}
+
 } // namespace
 
 MeshArrays mesh_arrays(const MeshModel &mesh) {
@@ -37,6 +56,10 @@ MeshArrays mesh_arrays(const MeshModel &mesh) {
   Matrix44m normal_matrix = vcg::Inverse(cm.Tr);
   normal_matrix.transposeInPlace();
 
+  CMeshO &mutable_cm = const_cast<CMeshO &>(cm);  // vcglib's attribute lookup is not const
+  const bool saved_colors = has_input_colors(cm);
+  auto input_colors = saved_colors ? ColorAlloc::FindPerVertexAttribute<vcg::Color4b>(mutable_cm, kInputColorAttribute)
+                                   : CMeshO::PerVertexAttributeHandle<vcg::Color4b>();
   bool any_normal = false;
   for (size_t i = 0; i < cm.vert.size(); ++i) {
     const CVertexO &v = cm.vert[i];
@@ -55,7 +78,8 @@ MeshArrays mesh_arrays(const MeshModel &mesh) {
       out.data.normals.push_back(n[k]);
     }
     if (n[0] != 0 || n[1] != 0 || n[2] != 0) any_normal = true;
-    const vcg::Color4b &c = v.cC();  // always present in CMeshO (white when never set)
+    // Always present in CMeshO (white when never set); the colours from before our filters if saved.
+    const vcg::Color4b c = saved_colors ? input_colors[i] : v.cC();
     for (int k = 0; k < 4; ++k) out.data.colors.push_back(c[k]);
   }
   if (!out.vertex_index.empty() && !any_normal)
@@ -122,6 +146,7 @@ void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<
     for (size_t i = 0; i < n; ++i) cm.vert[arrays.vertex_index[i]].Q() = quality[i];
   }
   mesh.updateDataMask(MeshModel::MM_VERTCOLOR);
+  if (colors_rgba.size() == 4 * n) save_input_colors_once(cm);
   if (colors_rgba.size() == 4 * n)
     for (size_t i = 0; i < n; ++i) {
       const uint8_t *c = &colors_rgba[4 * i];

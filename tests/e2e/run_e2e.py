@@ -79,6 +79,16 @@ def cmd_fit(a):
     values["outputPly"] = out_ply
     mlx = os.path.join(work, "fit.mlx")
     lib.write_mlx(a.mlx, mlx, values)
+    if a.before_mlx:  # run other filters first (e.g. coverage, which repaints the mesh) in one script
+        script = ET.parse(a.before_mlx).getroot()
+        for param in script.iter("Param"):  # keep whatever those filters write out of the inputs
+            if param.get("name") == "suggestionFile":
+                param.set("value", os.path.join(out_dir, "suggestions.txt"))
+        fit_script = ET.parse(mlx).getroot()
+        for f in list(fit_script):
+            script.append(f)
+        with open(mlx, "w", encoding="utf-8") as f:
+            f.write("<!DOCTYPE FilterScript>\n" + ET.tostring(script, encoding="unicode") + "\n")
     rc, log = run_meshlabserver(a.wrapper, project, mlx, os.path.join(work, "meshlabserver.log"))
     failures = []
     if rc != 0:
@@ -321,6 +331,7 @@ def main(argv=None):
     fit.add_argument("--photo-dir", help="use these photos (same file names) instead of the project's")
     fit.add_argument("--set", action="append", help="filter parameter name=value")
     fit.add_argument("--expect-log", action="append", help="text the meshlabserver log must contain")
+    fit.add_argument("--before-mlx", help="an .mlx whose filters run before the fit in the same script")
     fit.add_argument("--transformed", action="store_true",
                      help="run on a copy whose mesh carries a layer matrix (same world geometry)")
     fit.add_argument("--fit", choices=["scalar", "diag", "matrix"], default="scalar")
