@@ -13,11 +13,11 @@
 //   as a sum of squares when it cancels, so that the singularity test means what it does in double;
 // - the objective is summed with Kahan compensation: the 1e-5 convergence test is near the
 //   rounding error of a plain float sum over a few hundred samples.
-// Where the reference breaks the contract, this keeps it: a sample with N.L = +Inf is not usable
-// (the reference's k_d becomes NaN); the alpha_from_highlights fallback is the clamped alpha_init
-// (the reference returns it unclamped); the 1e-30 floors apply to the scaled problem, so pixel
-// values far below 1 are fitted like ordinary ones (the reference's max(E, 1e-30) gain floor
-// stops every fit after its first step once E < ~1e-30, i.e. pixel values ~1e-13 and below).
+// Both back ends keep the contract alike (tests/unit/test_phong_gpu.cpp): a sample with N.L = +Inf
+// is not usable; the alpha_from_highlights fallback is the clamped alpha_init; the convergence
+// floor is relative to the data's scale, so very small pixel values are fitted like ordinary ones.
+// The fallback fit for vertices without a strictly usable sample (fit_vertex_weak, fit_status 4)
+// and the neighbour fill (fit_status 3) run on the CPU after either back end (core/pipeline.cpp).
 layout(local_size_x = 64) in;
 
 struct Sample {  // core/samples.h Sample, 24 bytes

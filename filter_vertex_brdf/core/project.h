@@ -1,5 +1,6 @@
 #pragma once
-// A registered MeshLab project: one mesh plus photos (rasters) with their shots and lights.
+// A registered MeshLab project: one mesh plus photos (rasters) with their shots. Light directions
+// are not part of it: they come from an .lp file (light_file.h).
 #include <string>
 #include <vector>
 

@@ -167,12 +167,12 @@ void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<
 GlContextScope::GlContextScope(MLPluginGLContext *context, const std::function<void(const std::string &)> &log) {
   if (context == nullptr) return;  // CPU chosen, or no view: the core says which back end runs
   if (!context->isValid()) {
-    log("MeshLab's OpenGL context is not valid: visibility runs on the CPU.");
+    log("MeshLab's OpenGL context is not valid: the GL passes and the compute-shader fit are unavailable; the CPU back ends run.");
     return;
   }
   context->makeCurrent();
   if (QGLContext::currentContext() != context) {
-    log("MeshLab's OpenGL context could not be made current: visibility runs on the CPU.");
+    log("MeshLab's OpenGL context could not be made current: the GL passes and the compute-shader fit are unavailable; the CPU back ends run.");
     return;
   }
   context_ = context;
