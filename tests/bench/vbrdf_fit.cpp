@@ -1,6 +1,6 @@
 // vbrdf_fit: runs the filter's core pipeline on a .mlp without MeshLab (GL through OSMesa).
 //   vbrdf_fit project.mlp [--lp lights.lp] [--out result.ply] [--visibility auto|gl|cpu]
-//             [--ts 0.9] [--td 0.5] [--encoding auto|srgb|linear] [--shadow-map 2048]
+//             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
