@@ -131,10 +131,15 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
 namespace {
 class CpuFitter : public PhongFitter {
 public:
-  const char *name() const override { return "CPU (double, OpenMP)"; }
+  // `why`: how it came to be chosen, appended to the name (the report shows it).
+  explicit CpuFitter(const std::string &why = "") : name_("CPU (double, OpenMP)" + (why.empty() ? "" : "; " + why)) {}
+  const char *name() const override { return name_.c_str(); }
   void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
     fit_chunk_cpu(chunk, o, out);
   }
+
+private:
+  std::string name_;
 };
 
 class GpuFitter : public PhongFitter {
@@ -462,20 +467,6 @@ bool software_renderer(const std::string &device) {
     if (d.find(name) != std::string::npos) return true;
   return false;
 }
-
-class AutoCpuFitter : public PhongFitter {
-public:
-  explicit AutoCpuFitter(const std::string &device)
-      : name_("CPU (double, OpenMP); Auto chose it over the compute shader: the GL context is a software "
-              "renderer (" + device + ")") {}
-  const char *name() const override { return name_.c_str(); }
-  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
-    fit_chunk_cpu(chunk, o, out);
-  }
-
-private:
-  std::string name_;
-};
 } // namespace
 
 std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
@@ -485,7 +476,8 @@ std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
       try {
         std::unique_ptr<GpuFitter> gpu(new GpuFitter(get_proc));
         if (settings.fit_backend == FitBackendChoice::Auto && software_renderer(gpu->device())) {
-          std::unique_ptr<PhongFitter> cpu(new AutoCpuFitter(gpu->device()));
+          std::unique_ptr<PhongFitter> cpu(new CpuFitter(
+              "Auto chose it over the compute shader: the GL context is a software renderer (" + gpu->device() + ")"));
           log(std::string("Phong fit: ") + cpu->name() + ". Set 'fitBackend' to GPU to use the shader anyway.");
           return cpu;
         }

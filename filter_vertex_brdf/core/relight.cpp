@@ -121,25 +121,21 @@ struct Scored {
 
 // The prediction of the photo's bilinear sample at image point (x, y) whose footprint pixels
 // `own` (visibility.h's mask, from the camera pass) show the vertex's own surface
-// (RelightOptions::rendered): those take the vertex's model, the others the mean of the render's
-// subpixels there (background, another surface), as the sensor integrates them.
-void predict_footprint(const FineRender &render, float x, float y, uint8_t own, const float vertex_rgb[3],
+// (RelightOptions::rendered): those take the vertex's model, the others the rendered image there
+// (background, another surface).
+void predict_footprint(const cv::Mat &rendered, float x, float y, uint8_t own, const float vertex_rgb[3],
                        float out[3]) {
   const float fx = x - 0.5f, fy = y - 0.5f;
-  const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy)), s = render.scale;
-  const int width = render.rgb.cols / s, height = render.rgb.rows / s;
+  const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
   const float ax = fx - float(x0), ay = fy - float(y0);
   const float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
   for (int c = 0; c < 3; ++c) out[c] = 0;
   for (int k = 0; k < 4; ++k) {
-    float texel[3] = {vertex_rgb[0], vertex_rgb[1], vertex_rgb[2]};
+    const float *texel = vertex_rgb;
     if (!(own >> k & 1u)) {
-      const int xi = std::min(std::max(x0 + k % 2, 0), width - 1), yi = std::min(std::max(y0 + k / 2, 0), height - 1);
-      texel[0] = texel[1] = texel[2] = 0;
-      for (int sy = 0; sy < s; ++sy) {
-        const float *rgb = render.rgb.ptr<float>(yi * s + sy) + 3 * xi * s;
-        for (int i = 0; i < 3 * s; ++i) texel[i % 3] += rgb[i] / float(s * s);
-      }
+      const int xi = std::min(std::max(x0 + k % 2, 0), rendered.cols - 1);
+      const int yi = std::min(std::max(y0 + k / 2, 0), rendered.rows - 1);
+      texel = rendered.ptr<float>(yi) + 3 * xi;
     }
     for (int c = 0; c < 3; ++c) out[c] += w[k] * texel[c];
   }
@@ -163,12 +159,10 @@ void check_sizes(const MeshView &mesh, const std::vector<VertexFit> &fits, const
     throw InputError("Relighting evaluation: one rendered image per held-out photo is needed.");
   if (options.rendered)
     for (size_t r = 0; r < rasters.size(); ++r)
-      if ((*options.rendered)[r].rgb.type() != CV_32FC3 || (*options.rendered)[r].depth.type() != CV_32F ||
-          (*options.rendered)[r].rgb.cols != rasters[r].width() * (*options.rendered)[r].scale ||
-          (*options.rendered)[r].rgb.rows != rasters[r].height() * (*options.rendered)[r].scale ||
-          (*options.rendered)[r].depth.size() != (*options.rendered)[r].rgb.size())
+      if ((*options.rendered)[r].type() != CV_32FC3 || (*options.rendered)[r].cols != rasters[r].width() ||
+          (*options.rendered)[r].rows != rasters[r].height())
         throw InputError("Relighting evaluation: the rendered image of '" + rasters[r].label +
-                         "' does not match the photo's size.");
+                         "' is not a linear RGB float image of the photo's size.");
   if (options.lit_filter && options.lit_filter->size() != mesh.vertex_count * rasters.size())
     throw InputError("Relighting evaluation: the lit filter has " + std::to_string(options.lit_filter->size()) +
                      " entries; expected held-out photos x vertices = " +
@@ -236,7 +230,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         Scored r{};
         r.raster = s.raster;
         r.mixed = (s.flags & kMixedPixel) != 0;
-        r.modelled = fit.status != kFitNone;
+        r.modelled = has_model(fit);
         float predicted[3];
         evaluate_phong(fit, s.n_dot_l, s.r_dot_e, predicted);
         const uint8_t own = masks.own_texels(s.raster, v);
@@ -270,7 +264,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
       }
     }
     for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
-      const bool modelled = fits[chunk.first_vertex + i].status != kFitNone;
+      const bool modelled = has_model(fits[chunk.first_vertex + i]);
       if (seen[i]) {
         ++stats.seen_vertices;
         if (!modelled) ++stats.seen_unmodelled_vertices;

@@ -37,14 +37,13 @@ struct RelightOptions {
   // `heldout_lit`). Where given it replaces the shadow flags: lit samples are scored even where our
   // shadow map disagrees, unlit ones never are.
   const std::vector<uint8_t> *lit_filter = nullptr;
-  // Optional (null = the vertex's model alone): per held-out raster, the model rendered with
-  // subpixels for that camera (relight_render.h render_supersampled). The product then predicts a
+  // Optional (null = the vertex's model alone): per held-out raster, the model's image as that
+  // camera records it (relight_render.h render_as_photographed). The product then predicts a
   // sample as the photo is sampled: bilinearly over the vertex's 2x2 pixel footprint, where the
   // pixels on the vertex's own surface (the camera pass's footprint mask) take the vertex's model
   // (evaluate_phong) and, at silhouettes and contacts, the others (background, another surface)
-  // the render's mean over their subpixels, as a sensor pixel integrates. Inside a surface this is
-  // exactly the vertex's model.
-  const std::vector<FineRender> *rendered = nullptr;
+  // take that image. Inside a surface this is exactly the vertex's model.
+  const std::vector<cv::Mat> *rendered = nullptr;
   // Optional baselines (both null = off): the training rasters and their world light directions.
   // For each held-out raster the training rasters of the same viewpoint (same_shot) are used; the
   // vertex's samples there (plain bilinear, shadowed kept, saturated dropped) fit PTM and RBF.

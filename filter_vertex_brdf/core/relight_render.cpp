@@ -475,11 +475,11 @@ RelitImage RelightRenderer::render(const Shot &shot, const float light_dir_world
 
 const char *RelightRenderer::renderer_name() const { return impl_->renderer.c_str(); }
 
-FineRender render_supersampled(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
+cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
                                int max_scale) {
   const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
   int s = std::max(1, max_scale);
-  // Memory (16 bytes per fine pixel) and GL limits (8192 per side everywhere).
+  // Memory (16 bytes per subpixel) and GL limits (8192 per side everywhere).
   while (s > 1 && (double(width) * height * s * s > double(1 << 23) || width * s > 8192 || height * s > 8192)) --s;
   Shot fine = shot;  // the same camera with s x s smaller pixels (VCG pixels scale by s)
   fine.Intrinsics.ViewportPx[0] = width * s;
@@ -489,10 +489,10 @@ FineRender render_supersampled(RelightRenderer &renderer, const Shot &shot, cons
     fine.Intrinsics.CenterPx[k] *= float(s);
   }
   const RelitImage image = renderer.render(fine, light_dir_world);
-  FineRender out;
-  out.scale = s;
-  cv::Mat(image.height, image.width, CV_32FC3, const_cast<float *>(image.rgb.data())).copyTo(out.rgb);
-  cv::Mat(image.height, image.width, CV_32F, const_cast<float *>(image.depth.data())).copyTo(out.depth);
+  const cv::Mat fine_rgb(image.height, image.width, CV_32FC3, const_cast<float *>(image.rgb.data()));
+  cv::Mat out;
+  if (s == 1) fine_rgb.copyTo(out);
+  else cv::resize(fine_rgb, out, cv::Size(width, height), 0, 0, cv::INTER_AREA);  // exact s x s box mean
   return out;
 }
 

@@ -82,16 +82,12 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
-// The model rendered for the camera of `shot` with `scale` x `scale` subpixels per photo pixel
-// (pixel (x, y) of the photo covers fine pixels [x*scale, (x+1)*scale) x [y*scale, (y+1)*scale)),
-// so that what a sensor pixel integrates at silhouettes and contacts can be predicted. `scale` is
-// max_scale, reduced for large photos (at most 2^23 fine pixels) and to the GL size limits.
-struct FineRender {
-  int scale = 1;
-  cv::Mat rgb;    // CV_32FC3 linear RGB, row 0 = top; background and shadow 0
-  cv::Mat depth;  // CV_32F view depth of the surface, 0 on background
-};
-FineRender render_supersampled(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
+// The model's image as the camera of `shot` records it: rendered with up to `max_scale` x
+// `max_scale` subpixels per photo pixel (fewer for large photos: at most 2^23 subpixels, and
+// within the GL size limits) and box-filtered back to the photo's size, as a sensor pixel
+// integrates the light over its area, so that silhouettes and contacts are partly covered as in
+// a photo. CV_32FC3 linear RGB, row 0 = top, the shot's size; background and shadow 0.
+cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
                                int max_scale = 4);
 
 // Per-pixel comparison of a render with a photo of the same camera.

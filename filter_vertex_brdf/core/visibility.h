@@ -38,6 +38,11 @@ constexpr uint8_t kAllFootprintTexels = 0xF;
 // mask stands for texel (x0 + k % 2, y0 + k / 2).
 inline uint8_t footprint_texel_bit(int k) { return uint8_t(1u << k); }
 
+// The camera-pass code of a vertex that is not hidden, from the mask of its own-surface texels.
+inline uint8_t camera_code_of(uint8_t own_texels) {
+  return own_texels == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | own_texels);
+}
+
 // How far a texel's surface depth may differ from the vertex's depth and still count as the
 // vertex's own (continuous) surface: across 1.5 texels the depth of a surface seen at up to 79
 // degrees from the view axis (slope tan = 5) changes by 1.5 * 5 * (world size of a texel), plus

@@ -218,7 +218,7 @@ uint8_t CpuVisibility::footprint_code(MarkState &marks, const Shot &shot, const 
                                    std::numeric_limits<float>::infinity();
     if (surface_in_window && !blocked(marks, window, -dir, near_depth * len)) mask |= footprint_texel_bit(k);
   }
-  return mask == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | mask);
+  return camera_code_of(mask);
 }
 
 void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {

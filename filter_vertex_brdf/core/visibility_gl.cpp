@@ -76,7 +76,7 @@ inline uint8_t footprint_code(const float *map, int w, int h, float ix, float iy
     if (i < 0 || row < 0 || i >= w || row >= h) continue;
     if (std::fabs(map[size_t(row) * size_t(w) + size_t(i)] - depth) <= allowed) mask |= footprint_texel_bit(k);
   }
-  return mask == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | mask);
+  return camera_code_of(mask);
 }
 
 // An FBO with an R32F colour texture (linear depth) and a 32F depth renderbuffer.

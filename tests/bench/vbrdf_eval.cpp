@@ -183,13 +183,13 @@ int main(int argc, char **argv) {
     } else {
       visibility = make_cpu_visibility(result.mesh.view(), VisibilitySettings());
     }
-    std::vector<FineRender> rendered;
+    std::vector<cv::Mat> rendered;
     std::unique_ptr<RelightRenderer> renderer;
     if (predict == "render") {
       if (!context) context.reset(new test::OsMesaContext());
       renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address()));
       for (size_t r = 0; r < heldout.project.rasters.size(); ++r)
-        rendered.push_back(render_supersampled(*renderer, heldout.project.rasters[r].shot, heldout.lights[r].data()));
+        rendered.push_back(render_as_photographed(*renderer, heldout.project.rasters[r].shot, heldout.lights[r].data()));
       options.rendered = &rendered;
     } else if (predict != "vertex") {
       throw InputError("--predict takes 'render' or 'vertex'");

@@ -297,9 +297,9 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
   out.num("relit_median", c.median_de2000);
   out.num("relit_p95", c.p95_de2000);
   out.num("relit_psnr", c.psnr_db);
-  std::vector<FineRender> rendered;
+  std::vector<cv::Mat> rendered;
   for (size_t r = 0; r < h.rasters.size(); ++r)
-    rendered.push_back(render_supersampled(renderer, h.rasters[r].shot, h.lights[r].data()));
+    rendered.push_back(render_as_photographed(renderer, h.rasters[r].shot, h.lights[r].data()));
   auto visibility = make_gl_visibility(mesh.view(), get_proc, VisibilitySettings());
   RelightOptions ro;
   ro.rendered = &rendered;
