@@ -217,8 +217,9 @@ CandidateSet gather_candidates(const MeshView &mesh, const std::vector<Raster> &
   set.shot = rasters.front().shot;
   set.lights_world = lights_world;
   for (const Raster &r : rasters) set.names.push_back(r.label);
+  const std::vector<LightSource> sources = directional_lights(lights_world);
   const VisibilityMasks masks = compute_visibility(
-      mesh, rasters, lights_world, visibility, [&](float f, const char *s) { return !progress || progress(0.5f * f, s); });
+      mesh, rasters, sources, visibility, [&](float f, const char *s) { return !progress || progress(0.5f * f, s); });
   set.words = masks.words();
   set.visible.assign(mesh.vertex_count, 0);
   for (size_t v = 0; v < mesh.vertex_count; ++v) set.visible[v] = masks.is_seen(0, v) && masks.own_texels(0, v) != 0;
@@ -226,7 +227,7 @@ CandidateSet gather_candidates(const MeshView &mesh, const std::vector<Raster> &
   set.specular.assign(set.words * rasters.size(), 0);
   PhotoCache photos(gather.encoding, gather.saturation_level, gather.photo_cache_bytes);
   gather_samples(
-      mesh, rasters, lights_world, masks, gather, photos,
+      mesh, rasters, sources, masks, gather, photos,
       [&](const SampleChunk &chunk) {
         for (uint32_t i = 0; i < chunk.vertex_count; ++i)
           for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {

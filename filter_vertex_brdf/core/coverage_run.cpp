@@ -735,13 +735,14 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   for (const Raster &raster : input.rasters) photos.get(raster.image_path, raster.width(), raster.height());
 
   auto t = Clock::now();
-  const VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility,
+  const std::vector<LightSource> sources = directional_lights(lights);
+  const VisibilityMasks masks = compute_visibility(mesh, input.rasters, sources, visibility,
                                                    [&](float f, const char *s) { return !progress || progress(0.45f * f, s); });
   r.seconds_visibility = seconds_since(t);
 
   t = Clock::now();
   r.counts.assign(n, CoverageCounts());
-  gather_samples(mesh, input.rasters, lights, masks, settings.gather, photos,
+  gather_samples(mesh, input.rasters, sources, masks, settings.gather, photos,
                  [&](const SampleChunk &chunk) { count_coverage_chunk(chunk, &r.counts[chunk.first_vertex]); },
                  [&](float f, const char *s) { return !progress || progress(0.45f + 0.45f * f, s); });
   r.seconds_gather = seconds_since(t);

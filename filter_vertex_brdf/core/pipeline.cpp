@@ -9,6 +9,7 @@
 #include "errors.h"
 #include "file_util.h"
 #include "light_file.h"
+#include "light_source.h"
 #include "output_ply.h"
 #include "phong_fit_gpu.h"
 #include "result_schema.h"
@@ -53,29 +54,6 @@ int bit(uint16_t flag) {
 std::string default_output_path(const std::string &project_path) {
   if (project_path.empty()) return "vertex_brdf.ply";
   return strip_extension(project_path) + "_brdf.ply";
-}
-
-std::vector<std::array<float, 3>> resolve_light_directions(const std::vector<Raster> &rasters,
-                                                           const std::string &lp_path) {
-  const std::vector<LightEntry> lights = read_light_file(lp_path);
-  std::vector<bool> used(lights.size(), false);
-  std::vector<std::array<float, 3>> dirs(rasters.size());
-  for (size_t r = 0; r < rasters.size(); ++r) {
-    const int i = find_light_for_image(lights, rasters[r].image_path);
-    if (i < 0)
-      throw InputError("Light file '" + lp_path + "' has no entry for raster '" + rasters[r].label + "' (image '" +
-                       file_name_of(rasters[r].image_path) + "'): add a line for it or choose the matching .lp.");
-    used[size_t(i)] = true;
-    camera_to_world_direction(rasters[r].shot, lights[size_t(i)].dir_cam, dirs[r].data());
-  }
-  if (lights.size() != rasters.size()) {
-    for (size_t i = 0; i < lights.size(); ++i)
-      if (!used[i])
-        throw InputError("Light file '" + lp_path + "' has " + std::to_string(lights.size()) + " lights but the project has " +
-                         std::to_string(rasters.size()) + " rasters; entry '" + lights[i].image +
-                         "' matches no raster. Use the .lp written for these photos.");
-  }
-  return dirs;
 }
 
 std::vector<std::vector<size_t>> rasters_by_viewpoint(const std::vector<Raster> &rasters) {
@@ -396,7 +374,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   std::ostringstream rep;
   rep << "filter_vertex_brdf report\n"
       << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
-      << "photos: " << input.rasters.size() << ", lights: " << r.light_file << "\n"
+      << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
       << "visibility back end: " << r.visibility_backend << "\n"
       << color_report(r, settings)
       << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
@@ -520,8 +498,11 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
                      "'lightFile' to the .lp that gives each photo's light direction, or add the missing lines." +
                      why);
   }
-  const auto lights = resolve_light_directions(input.rasters, result.light_file);
-  log("Lights: " + std::to_string(lights.size()) + " directions from '" + result.light_file + "'.");
+  const LightPlacement placement =
+      light_placement_of(mesh.positions, mesh.vertex_count, settings.dome_radius, settings.light_unit_scale);
+  const std::vector<LightSource> lights = resolve_lights(input.rasters, result.light_file, placement);
+  result.light_model = describe_lights(lights, placement);
+  log("Lights: " + result.light_model + ", from '" + result.light_file + "'.");
 
   result.output_ply = settings.output_ply.empty() ? default_output_path(input.project_path) : settings.output_ply;
   for (const std::string &protected_path : {input.project_path, input.mesh_path})
@@ -533,7 +514,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   for (const Raster &r : input.rasters) photos.get(r.image_path, r.width(), r.height());
   // Before the long passes: a required chart that is missing fails early.
   if (progress) progress(0.0f, "colour calibration");
-  ColorPlan colors = plan_colors(input, settings, lights, photos, log);
+  ColorPlan colors = plan_colors(input, settings, light_directions(lights), photos, log);
   const bool correct = colors.any_corrected();
   result.color_viewpoints_corrected = size_t(std::count_if(
       colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
@@ -551,6 +532,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
       mesh, input.rasters, lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
         if (correct) correct_colors(colors, chunk);
+        apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
         consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
       },
       gather_progress);

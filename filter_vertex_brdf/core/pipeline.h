@@ -50,7 +50,9 @@ struct FitSettings {
   // viewpoint; 8 per viewpoint = one group each, viewpoints in order of their first raster.
   std::vector<float> chart_corners;
   ExposureMode exposure = ExposureMode::Auto;  // per-photo normalisation by the chart's neutrals
-  std::string light_file;   // "" = find_default_light_file (light_file.h)
+  std::string light_file;   // "" = find_default_light_file (light_file.h); .lp, .json or .dome (light_source.h)
+  float dome_radius = 0;     // > 0: the .lp's directions are point lights this far from the mesh's centre
+  float light_unit_scale = 0;  // mesh units per unit of the light file's positions (0: .json 1, .dome required)
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
   // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.
@@ -66,11 +68,6 @@ struct FitInput {
   std::string project_path;            // the .mlp, used for default paths (may be empty)
 };
 
-// Per-raster world light directions from an .lp, matched by image file name.
-// Throws InputError naming the .lp and the raster when a raster has no entry, and naming
-// the entry when an .lp line matches no raster (a count or name mismatch).
-std::vector<std::array<float, 3>> resolve_light_directions(const std::vector<Raster> &rasters,
-                                                           const std::string &lp_path);
 
 // Rasters grouped by viewpoint: photos of one viewpoint share one registration (an identical shot,
 // equal to 1e-6 relative). Groups are in order of their first raster; indices ascending.
@@ -95,7 +92,8 @@ struct FitResult {
   size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
   NeighbourFillStats fill;
   double seconds_fit = 0;
-  std::string light_file;                 // the .lp used
+  std::string light_file;                 // the light file used (.lp, .json or .dome)
+  std::string light_model;                // describe_lights: directional / point lights and their distances
   std::vector<ColorCalibration> colors;   // per viewpoint (rasters_by_viewpoint order); empty when Off
   size_t color_viewpoints_corrected = 0;
   std::string output_ply;                 // where the PLY was written

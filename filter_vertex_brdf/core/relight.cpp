@@ -167,16 +167,17 @@ void check_sizes(const MeshView &mesh, const std::vector<VertexFit> &fits, const
     throw InputError("Relighting evaluation: the lit filter has " + std::to_string(options.lit_filter->size()) +
                      " entries; expected held-out photos x vertices = " +
                      std::to_string(mesh.vertex_count * rasters.size()) + ".");
-  if (bool(options.training_rasters) != bool(options.training_light_dirs_world) ||
-      (options.training_rasters && options.training_rasters->size() != options.training_light_dirs_world->size()))
+  if (bool(options.training_rasters) != bool(options.training_lights) ||
+      (options.training_rasters && options.training_rasters->size() != options.training_lights->size()))
     throw InputError("Relighting evaluation: the baselines need one light direction per training photo.");
 }
 } // namespace
 
 RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexFit> &fits,
                                  const std::vector<Raster> &rasters,
-                                 const std::vector<std::array<float, 3>> &light_dirs_world, VisibilityBackend &visibility,
+                                 const std::vector<LightSource> &lights, VisibilityBackend &visibility,
                                  const RelightOptions &options) {
+  const std::vector<std::array<float, 3>> light_dirs_world = light_directions(lights);
   check_sizes(mesh, fits, rasters, light_dirs_world, options);
   const size_t n_held = rasters.size();
   const bool baselines = options.training_rasters != nullptr;
@@ -187,13 +188,12 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
 
   // Held-out and training photos are gathered in one pass: raster indices >= n_held are training.
   std::vector<Raster> all = rasters;
-  std::vector<std::array<float, 3>> all_lights = light_dirs_world;
+  std::vector<LightSource> all_lights = lights;
   BaselinePlan plan;
   if (baselines) {
     all.insert(all.end(), options.training_rasters->begin(), options.training_rasters->end());
-    all_lights.insert(all_lights.end(), options.training_light_dirs_world->begin(),
-                      options.training_light_dirs_world->end());
-    plan = plan_baselines(rasters, light_dirs_world, *options.training_rasters, *options.training_light_dirs_world);
+    all_lights.insert(all_lights.end(), options.training_lights->begin(), options.training_lights->end());
+    plan = plan_baselines(rasters, light_dirs_world, *options.training_rasters, light_directions(*options.training_lights));
     stats.rbf_sigma_per_raster.assign(n_held, 0.0f);
     for (size_t h = 0; h < n_held; ++h)
       if (plan.viewpoint_of_heldout[h] >= 0)
@@ -233,6 +233,8 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         r.modelled = has_model(fit);
         float predicted[3];
         evaluate_phong(fit, s.n_dot_l, s.r_dot_e, predicted);
+        const float irradiance = light_irradiance_at(lights[s.raster], mesh.positions + 3 * v);
+        for (float &c : predicted) c *= irradiance;
         const uint8_t own = masks.own_texels(s.raster, v);
         if (options.rendered && own != kAllFootprintTexels) {
           const ImagePoint ip = project_to_image(rasters[s.raster].shot, mesh.positions + 3 * v);

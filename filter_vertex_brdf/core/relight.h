@@ -44,11 +44,12 @@ struct RelightOptions {
   // (evaluate_phong) and, at silhouettes and contacts, the others (background, another surface)
   // take that image. Inside a surface this is exactly the vertex's model.
   const std::vector<cv::Mat> *rendered = nullptr;
-  // Optional baselines (both null = off): the training rasters and their world light directions.
+  // Optional baselines (both null = off): the training rasters and their lights (the baselines,
+  // per-pixel RTI, use one direction per photo: LightSource::direction, as RTI tools do).
   // For each held-out raster the training rasters of the same viewpoint (same_shot) are used; the
   // vertex's samples there (plain bilinear, shadowed kept, saturated dropped) fit PTM and RBF.
   const std::vector<Raster> *training_rasters = nullptr;
-  const std::vector<std::array<float, 3>> *training_light_dirs_world = nullptr;
+  const std::vector<LightSource> *training_lights = nullptr;
   float rbf_ridge = 1e-3f;
 };
 
@@ -90,13 +91,15 @@ struct RelightStats {
   std::vector<float> rbf_sigma_per_raster;  // sigma used for each held-out raster (0: no training viewpoint)
 };
 
-// `fits` has one entry per vertex; `rasters` / `light_dirs_world` are the held-out photos. Any
+// `fits` has one entry per vertex; `rasters` / `lights` are the held-out photos. The product
+// predicts evaluate_phong times the light's irradiance at the vertex (light_irradiance_at: point
+// lights fall off with distance; directional ones give their intensity, 1). Any
 // status other than kFitNone counts as modelled. Visibility comes from `visibility` (built for
 // `mesh`); held-out and training photos are gathered in one pass. Throws InputError on size
 // mismatches (fits, lights, filter, training lights). All outputs are finite.
 RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexFit> &fits,
                                  const std::vector<Raster> &rasters,
-                                 const std::vector<std::array<float, 3>> &light_dirs_world, VisibilityBackend &visibility,
+                                 const std::vector<LightSource> &lights, VisibilityBackend &visibility,
                                  const RelightOptions &options = RelightOptions());
 
 } // namespace vbrdf

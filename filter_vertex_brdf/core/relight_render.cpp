@@ -18,6 +18,7 @@
 #include "errors.h"
 #include "file_util.h"
 #include "gl_api.h"
+#include "light_view.h"
 #include "output_ply.h"  // write_text_file_atomically
 #include "visibility.h"  // resolved_shadow_map_size
 
@@ -61,9 +62,12 @@ in vec2 v_ks_alpha;
 in float v_depth;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
-uniform vec3 u_light_x;
-uniform vec3 u_light_y;
+uniform mat4 u_light_view;
 uniform float u_light_scale;
+uniform int u_light_perspective;
+uniform vec3 u_light_pos;
+uniform float u_light_reference;
+uniform float u_light_intensity;
 uniform int u_shadow_size;
 uniform float u_tolerance;
 uniform sampler2D u_shadow_map;
@@ -80,22 +84,34 @@ void main() {
   if (v_rho_fitted.a < 0.999) { o_color = vec4(0.0, 0.0, 0.0, 3.0); return; }
   float len = length(v_normal);
   vec3 n = len > 0.0 ? v_normal / len : v_normal;
-  float d = dot(n, u_light_dir);
+  // Light direction and irradiance at the fragment (light_source.h): a point light's change
+  // across the object, with the distance clamped as on the CPU.
+  vec3 l = u_light_dir;
+  float irradiance = u_light_intensity;
+  if (u_light_perspective != 0) {
+    vec3 to_light = u_light_pos - v_position;
+    float dist = max(length(to_light), 1e-3 * u_light_reference);
+    l = to_light / dist;
+    irradiance = u_light_intensity * (u_light_reference / dist) * (u_light_reference / dist);
+  }
+  float d = dot(n, l);
   if (!(d > 0.0)) { o_color = vec4(0.0, 0.0, 0.0, 2.0); return; }
-  float wx = dot(u_light_x, v_position) * u_light_scale + 0.5 * float(u_shadow_size);
-  float wy = dot(u_light_y, v_position) * u_light_scale + 0.5 * float(u_shadow_size);
+  vec4 lp = u_light_view * vec4(v_position, 1.0);
+  float light_depth = -lp.z;
+  float w = u_light_perspective != 0 ? max(light_depth, 1e-12) : 1.0;
+  float wx = (u_light_scale * lp.x / w + 1.0) * 0.5 * float(u_shadow_size);
+  float wy = (u_light_scale * lp.y / w + 1.0) * 0.5 * float(u_shadow_size);
   int i0 = int(floor(wx - 0.5)), j0 = int(floor(wy - 0.5));
   float far_depth = max(max(shadow_texel(i0, j0), shadow_texel(i0 + 1, j0)),
                         max(shadow_texel(i0, j0 + 1), shadow_texel(i0 + 1, j0 + 1)));
-  float light_depth = -dot(u_light_dir, v_position);
   if (light_depth > far_depth + u_tolerance) { o_color = vec4(0.0, 0.0, 0.0, 2.0); return; }
   vec3 e = normalize(u_eye - v_position);
-  vec3 r = 2.0 * d * n - u_light_dir;
+  vec3 r = 2.0 * d * n - l;
   float s = dot(r, e);
   float spec = 0.0;
   if (v_ks_alpha.x > 0.0 && s > 0.0)
     spec = v_ks_alpha.x * exp(max(v_ks_alpha.y * log(min(s, 1.0)), -80.0));
-  o_color = vec4(v_rho_fitted.rgb * d + vec3(spec), 1.0);
+  o_color = vec4((v_rho_fitted.rgb * d + vec3(spec)) * irradiance, 1.0);
 }
 )";
 
@@ -155,7 +171,7 @@ public:
   Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc,
        const RelightRenderSettings &settings);
   ~Impl() { release(); }
-  RelitImage render(const Shot &shot, const float light_dir_world[3]);
+  RelitImage render(const Shot &shot, const LightSource &light);
   std::string renderer;
 
 private:
@@ -164,8 +180,8 @@ private:
   void ensure_target(Target &t, int width, int height, bool camera, const std::string &what);
   void release_target(Target &t);
   void release();
-  void shadow_pass(const float d[3], const float x[3], const float y[3]);
-  void camera_pass(const Shot &shot, const float d[3], const float x[3], const float y[3], RelitImage &out);
+  void shadow_pass(const LightView &lv);
+  void camera_pass(const Shot &shot, const LightSource &light, const LightView &lv, RelitImage &out);
   void draw();
 
   GlApi gl_;
@@ -325,22 +341,13 @@ void RelightRenderer::Impl::draw() {
   if (index_count_ > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(index_count_), GL_UNSIGNED_INT, nullptr);
 }
 
-// Orthographic view along -d over the bounding sphere (as the visibility pass's light view).
-void RelightRenderer::Impl::shadow_pass(const float d[3], const float x[3], const float y[3]) {
+// The light's view (light_view.h, shared with the visibility pass).
+void RelightRenderer::Impl::shadow_pass(const LightView &lv) {
   const int size = settings_.shadow_map_size;
   ensure_target(shadow_target_, size, size, false, "the relighting shadow map");
-  const float r = std::max(radius_ * 1.01f + tolerance_, 1e-12f);
   Mat4 view, projection;
-  for (int k = 0; k < 3; ++k) {
-    view.at(0, k) = x[k];
-    view.at(1, k) = y[k];
-    view.at(2, k) = d[k];
-  }
-  view.at(3, 3) = 1;
-  projection.at(0, 0) = 1 / r;
-  projection.at(1, 1) = 1 / r;
-  projection.at(2, 2) = -1 / r;
-  projection.at(3, 3) = 1;
+  std::copy(lv.view, lv.view + 16, view.m);
+  std::copy(lv.projection, lv.projection + 16, projection.m);
   gl_.BindFramebuffer(GL_FRAMEBUFFER, shadow_target_.fbo);
   gl_.Viewport(0, 0, size, size);
   set_plain_raster_state(gl_);
@@ -355,7 +362,7 @@ void RelightRenderer::Impl::shadow_pass(const float d[3], const float x[3], cons
   check_gl_error(gl_, "the relighting shadow map pass");
 }
 
-void RelightRenderer::Impl::camera_pass(const Shot &shot, const float d[3], const float x[3], const float y[3],
+void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &light, const LightView &lv,
                                         RelitImage &out) {
   const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
   ensure_target(camera_target_, width, height, true, "the relighting camera pass");
@@ -395,12 +402,16 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const float d[3], cons
   gl_.UseProgram(p);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_view"), 1, GL_FALSE, view.m);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, projection.m);
+  const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
-  gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_x"), x[0], x[1], x[2]);
-  gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_y"), y[0], y[1], y[2]);
+  gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
+  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), lv.scale);
+  gl_.Uniform1i(gl_.GetUniformLocation(p, "u_light_perspective"), lv.perspective ? 1 : 0);
+  gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_pos"), light.position[0] - origin_[0],
+                light.position[1] - origin_[1], light.position[2] - origin_[2]);
+  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_reference"), std::max(light.reference_distance, 1e-12f));
+  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_intensity"), light.intensity);
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_eye"), eye[0], eye[1], eye[2]);
-  const float r = std::max(radius_ * 1.01f + tolerance_, 1e-12f);
-  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), 0.5f * float(settings_.shadow_map_size) / r);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_shadow_size"), settings_.shadow_map_size);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_tolerance"), tolerance_);
   // The host's active texture unit: GlStateGuard restores that unit's binding.
@@ -440,26 +451,22 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const float d[3], cons
   }
 }
 
-RelitImage RelightRenderer::Impl::render(const Shot &shot, const float light_dir_world[3]) {
+RelitImage RelightRenderer::Impl::render(const Shot &shot, const LightSource &light_in) {
   if (!shot_is_valid(shot))
     throw InputError("Relighting: the camera is not valid (zero focal length, pixel size, viewport or rotation).");
-  float d[3];
-  normalise(light_dir_world, d, "light direction");
-  // Light frame: z towards the light, x/y any orthonormal pair.
-  const int a = std::fabs(d[0]) < 0.6f ? 0 : (std::fabs(d[1]) < 0.6f ? 1 : 2);
-  float helper[3] = {0, 0, 0};
-  helper[a] = 1;
-  const float xr[3] = {helper[1] * d[2] - helper[2] * d[1], helper[2] * d[0] - helper[0] * d[2],
-                       helper[0] * d[1] - helper[1] * d[0]};
-  float x[3];
-  normalise(xr, x, "light frame");
-  const float y[3] = {d[1] * x[2] - d[2] * x[1], d[2] * x[0] - d[0] * x[2], d[0] * x[1] - d[1] * x[0]};
-
+  LightSource light = light_in;
+  if (!light.positional) normalise(light_in.direction.data(), light.direction.data(), "light direction");
+  LightView lv;
+  try {
+    lv = make_light_view(light, origin_, radius_ * 1.01f + tolerance_);
+  } catch (const InputError &e) {
+    throw InputError(std::string("Relighting: ") + e.what());
+  }
   RelitImage out;
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
-  shadow_pass(d, x, y);
-  camera_pass(shot, d, x, y, out);
+  shadow_pass(lv);
+  camera_pass(shot, light, lv, out);
   return out;
 }
 
@@ -469,13 +476,13 @@ RelightRenderer::RelightRenderer(const MeshView &mesh, const std::vector<VertexF
 
 RelightRenderer::~RelightRenderer() = default;
 
-RelitImage RelightRenderer::render(const Shot &shot, const float light_dir_world[3]) {
-  return impl_->render(shot, light_dir_world);
+RelitImage RelightRenderer::render(const Shot &shot, const LightSource &light) {
+  return impl_->render(shot, light);
 }
 
 const char *RelightRenderer::renderer_name() const { return impl_->renderer.c_str(); }
 
-cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
+cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, const LightSource &light,
                                int max_scale) {
   const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
   int s = std::max(1, max_scale);
@@ -488,7 +495,7 @@ cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, cons
     fine.Intrinsics.PixelSizeMm[k] /= float(s);
     fine.Intrinsics.CenterPx[k] *= float(s);
   }
-  const RelitImage image = renderer.render(fine, light_dir_world);
+  const RelitImage image = renderer.render(fine, light);
   const cv::Mat fine_rgb(image.height, image.width, CV_32FC3, const_cast<float *>(image.rgb.data()));
   cv::Mat out;
   if (s == 1) fine_rgb.copyTo(out);
@@ -888,7 +895,7 @@ ColorPlan plan_colors(const std::vector<Raster> &rasters, const std::vector<std:
   return plan;
 }
 
-PixelComparison relight_one(RelightRenderer &renderer, const Raster &raster, const float light[3],
+PixelComparison relight_one(RelightRenderer &renderer, const Raster &raster, const LightSource &light,
                             const RelightOutputOptions &options, const ColorCalibration *color, size_t color_photo,
                             RasterImages *images, PixelComparison *whole_surface) {
   if (!shot_is_valid(raster.shot))
@@ -940,10 +947,10 @@ std::string relight_table_csv(const std::vector<RelightRow> &rows) {
 }
 
 RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raster> &rasters,
-                              const std::vector<std::array<float, 3>> &light_dirs_world,
+                              const std::vector<LightSource> &lights,
                               const RelightOutputOptions &options, const ProgressFn &progress) {
-  if (light_dirs_world.size() != rasters.size())
-    throw ProcessingError("internal: " + std::to_string(light_dirs_world.size()) + " light directions for " +
+  if (lights.size() != rasters.size())
+    throw ProcessingError("internal: " + std::to_string(lights.size()) + " lights for " +
                           std::to_string(rasters.size()) + " rasters");
   const bool write = !options.folder.empty();
   std::vector<std::string> paths;
@@ -952,7 +959,7 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
     ensure_folder(options.folder);
   }
   RelightReport report;
-  const ColorPlan colors = plan_colors(rasters, light_dirs_world, options, report.color_log);
+  const ColorPlan colors = plan_colors(rasters, light_directions(lights), options, report.color_log);
   std::vector<cv::Mat> panels;
   for (size_t r = 0; r < rasters.size(); ++r) {
     if (progress && !progress(float(r) / float(std::max<size_t>(1, rasters.size())), "relighting"))
@@ -961,7 +968,7 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
     RelightRow row;
     row.label = rasters[r].label;
     row.photo = rasters[r].image_path;
-    row.comparison = relight_one(renderer, rasters[r], light_dirs_world[r].data(), options, colors.of_raster[r],
+    row.comparison = relight_one(renderer, rasters[r], lights[r], options, colors.of_raster[r],
                                  colors.photo_of[r], write ? &images : nullptr, &row.whole_surface);
     if (write) {
       panels.push_back(side_by_side(images.render, images.photo, images.heat, title_of(row), options.heat_map_max_de));

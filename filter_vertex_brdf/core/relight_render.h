@@ -26,6 +26,7 @@
 #include <opencv2/core.hpp>
 
 #include "camera.h"
+#include "light_source.h"
 #include "color_chart.h"
 #include "mesh_view.h"
 #include "phong_fit.h"
@@ -70,10 +71,12 @@ public:
   RelightRenderer(const RelightRenderer &) = delete;
   RelightRenderer &operator=(const RelightRenderer &) = delete;
 
-  // Renders the viewport of `shot` (no lens distortion) lit from the unit world direction
-  // `light_dir_world` (towards the light). Throws InputError for an invalid shot or a zero light
-  // direction, ProcessingError when the viewport exceeds the GL limits.
-  RelitImage render(const Shot &shot, const float light_dir_world[3]);
+  // Renders the viewport of `shot` (no lens distortion) lit by `light` (directional, or a point
+  // light with its per-fragment direction and fall-off, light_source.h), with cast shadows from
+  // light_view.h's shadow map. Throws InputError for an invalid shot, a zero light direction or a
+  // point light within the mesh's bounding sphere, ProcessingError when the viewport exceeds the
+  // GL limits.
+  RelitImage render(const Shot &shot, const LightSource &light);
 
   const char *renderer_name() const;  // GL_RENDERER, for logs
 
@@ -87,7 +90,7 @@ private:
 // within the GL size limits) and box-filtered back to the photo's size, as a sensor pixel
 // integrates the light over its area, so that silhouettes and contacts are partly covered as in
 // a photo. CV_32FC3 linear RGB, row 0 = top, the shot's size; background and shadow 0.
-cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, const float light_dir_world[3],
+cv::Mat render_as_photographed(RelightRenderer &renderer, const Shot &shot, const LightSource &light,
                                int max_scale = 4);
 
 // Per-pixel comparison of a render with a photo of the same camera.
@@ -181,7 +184,7 @@ struct RelightReport {
 // Rasters grouped by viewpoint (identical shots), groups in order of their first raster.
 std::vector<std::vector<size_t>> relight_viewpoints(const std::vector<Raster> &rasters);
 
-// Renders every raster's camera under its light (light_dirs_world[r], unit, world frame),
+// Renders every raster's camera under its light (lights[r]),
 // compares each render with the raster's photo (colour-corrected per viewpoint, see
 // RelightColorCorrection) and, when options.folder is set, writes
 // relight_NNN_<label>.png (render | photo | heat map; the label without its image extension),
@@ -192,7 +195,7 @@ std::vector<std::vector<size_t>> relight_viewpoints(const std::vector<Raster> &r
 // correction is Required and a viewpoint has no usable chart. `progress` may be empty; returning false cancels
 // (ProcessingError "cancelled").
 RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raster> &rasters,
-                              const std::vector<std::array<float, 3>> &light_dirs_world,
+                              const std::vector<LightSource> &lights,
                               const RelightOutputOptions &options, const ProgressFn &progress = {});
 
 // A new viewpoint from an existing camera: orbits it around `pivot` by `azimuth_deg` about the

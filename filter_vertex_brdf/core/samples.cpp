@@ -107,7 +107,7 @@ std::vector<uint32_t> footprint_list(const std::vector<uint8_t> &clear, const ui
 } // namespace
 
 VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
-                                   const std::vector<std::array<float, 3>> &light_dirs_world,
+                                   const std::vector<LightSource> &lights,
                                    VisibilityBackend &backend, const ProgressFn &progress) {
   VisibilityMasks masks;
   masks.vertex_count = mesh.vertex_count;
@@ -131,7 +131,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
     masks.footprints[r] = footprint_list(buffer, &masks.mixed[r * masks.words()], masks.words());
     if (counts[3] == 0) continue;  // a photo that sees nothing needs no shadow pass
     std::fill(buffer.begin(), buffer.end(), 0);
-    backend.light_pass(light_dirs_world[r].data(), buffer.data());
+    backend.light_pass(lights[r], buffer.data());
     pack_bits(buffer, &masks.lit[r * masks.words()]);
   }
   report(progress, 1.0f, "visibility");
@@ -139,7 +139,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
 }
 
 uint16_t make_sample(const float position[3], const float normal_in[3], const Raster &raster, uint16_t raster_index,
-                     const float light_dir[3], const Photo &photo, bool camera_clear, bool light_clear,
+                     const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
                      const GatherSettings &settings, Sample &out, uint8_t own_texels) {
   out = Sample{{0, 0, 0}, 0, 0, raster_index, 0};
   float n[3] = {normal_in[0], normal_in[1], normal_in[2]};
@@ -156,6 +156,8 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
   if (dot3(n, e) <= 0) flags |= kBackFacing;
   if (!camera_clear) flags |= kOccluded;
 
+  float light_dir[3];
+  light_direction_at(light, position, light_dir);
   const float d = dot3(n, light_dir);
   const float r[3] = {2 * d * n[0] - light_dir[0], 2 * d * n[1] - light_dir[1], 2 * d * n[2] - light_dir[2]};
   const float s = dot3(r, e);
@@ -181,7 +183,7 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
 }
 
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
-                           const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
+                           const std::vector<LightSource> &lights, const VisibilityMasks &masks,
                            const GatherSettings &settings, PhotoCache &photos,
                            const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress) {
   const auto start = std::chrono::steady_clock::now();
@@ -208,7 +210,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
         continue;
       }
       const auto photo = photos.get(raster.image_path, raster.width(), raster.height());
-      const float *light = light_dirs_world[r].data();
+      const LightSource &light = lights[r];
 #pragma omp parallel for schedule(dynamic, 1024)
       for (long long i = 0; i < (long long)count; ++i) {
         const size_t v = first + size_t(i);
@@ -250,6 +252,19 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
   stats.photo_loads = photos.loads();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
+}
+
+void apply_light_falloff(SampleChunk &chunk, const MeshView &mesh, const std::vector<LightSource> &lights) {
+  if (!any_positional(lights)) return;
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
+    const float *x = mesh.positions + 3 * (size_t(chunk.first_vertex) + size_t(i));
+    for (uint32_t k = chunk.offsets[size_t(i)]; k < chunk.offsets[size_t(i) + 1]; ++k) {
+      Sample &s = chunk.samples[k];
+      const float e = light_irradiance_at(lights[s.raster], x);
+      for (float &c : s.rgb) c /= e;
+    }
+  }
 }
 
 size_t prefer_clean_samples(SampleChunk &chunk, int min_clean) {

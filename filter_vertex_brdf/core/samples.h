@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "camera.h"
+#include "light_source.h"
 #include "mesh_view.h"
 #include "photo.h"
 #include "visibility.h"
@@ -94,13 +95,14 @@ struct VisibilityMasks {
 // ProcessingError("cancelled")).
 using ProgressFn = std::function<bool(float fraction, const char *stage)>;
 
-// Runs the camera and light depth passes for every raster. light_dirs_world[r] is the unit
-// direction towards the light of raster r.
+// Runs the camera and light depth passes for every raster. lights[r] is the light of raster r.
 VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
-                                   const std::vector<std::array<float, 3>> &light_dirs_world,
+                                   const std::vector<LightSource> &lights,
                                    VisibilityBackend &backend, const ProgressFn &progress = {});
 
-// Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`.
+// Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`,
+// lit by `light` (its direction at the vertex: light_direction_at). The colour is the photo's,
+// NOT divided by the light's fall-off (apply_light_falloff does that, after colour correction).
 // `camera_clear`/`light_clear` come from the depth passes (occlusion / cast shadow);
 // `own_texels` is the footprint mask of the camera pass (kAllFootprintTexels: a clean footprint).
 // A partial footprint gives kRimFootprint and the own texels' colour when
@@ -108,7 +110,7 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
 // colour. Returns the flags; when the result has any kNotSeen flag, `out` holds only flags and
 // geometry terms.
 uint16_t make_sample(const float position[3], const float normal[3], const Raster &raster, uint16_t raster_index,
-                     const float light_dir_world[3], const Photo &photo, bool camera_clear, bool light_clear,
+                     const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
                      const GatherSettings &settings, Sample &out, uint8_t own_texels = kAllFootprintTexels);
 
 struct SampleChunk {
@@ -135,9 +137,16 @@ struct GatherStats {
 // Only pairs the masks mark as seen are sampled; a photo that sees no vertex of a chunk is not
 // even loaded (GatherStats::rasters_skipped counts such raster x chunk pairs).
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
-                           const std::vector<std::array<float, 3>> &light_dirs_world, const VisibilityMasks &masks,
+                           const std::vector<LightSource> &lights, const VisibilityMasks &masks,
                            const GatherSettings &settings, PhotoCache &photos,
                            const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress = {});
+
+// Point lights: divides each sample's colour by the irradiance of its light at its vertex
+// (light_irradiance_at), so that the fit sees every sample as under unit light, as with
+// directional lights. Call it after colour correction (which need not be linear). Flags and the
+// saturation test (made on the photo's values) are unchanged. A no-op for directional lights;
+// the factor is finite and positive (clamped distance), so no NaN arises.
+void apply_light_falloff(SampleChunk &chunk, const MeshView &mesh, const std::vector<LightSource> &lights);
 
 // Rim samples (kRimFootprint: colour from part of a footprint that straddles a silhouette or
 // contact) still carry some of the other side through the sensor's pixel area. A vertex with at

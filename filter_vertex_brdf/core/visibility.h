@@ -1,6 +1,6 @@
 #pragma once
 // Occlusion tests for every vertex: from a camera (is another part of the mesh in front of it?)
-// and from a directional light (is the vertex in cast shadow?). Two back ends share this contract:
+// and from a light, directional or point (is the vertex in cast shadow?). Two back ends share this contract:
 // GL depth passes (visibility_gl.h) and a CPU ray-cast reference (visibility_cpu.h) used by tests.
 // Frustum, back-facing and attached-shadow (N.L <= 0) tests are NOT done here (samples.cpp does
 // them per vertex); these passes only answer "is other geometry in the way?".
@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "camera.h"
+#include "light_source.h"
 #include "mesh_view.h"
 
 namespace vbrdf {
@@ -66,9 +67,11 @@ public:
   // get kCameraClear (not this pass's concern). Both back ends implement the footprint test (GL
   // from its depth map, the CPU by casting the 4 texel rays).
   virtual void camera_pass(const Shot &shot, uint8_t *out) = 0;
-  // out[v] = 1 when no geometry lies between vertex v and a directional light shining from
-  // `dir_world` (unit vector towards the light), else 0 (cast shadow).
-  virtual void light_pass(const float dir_world[3], uint8_t *out) = 0;
+  // out[v] = 1 when no geometry lies between vertex v and the light, else 0 (cast shadow). A
+  // directional light shines from `light.direction` (an orthographic shadow map over the mesh; CPU:
+  // rays along it); a point light from `light.position` (a perspective shadow map from there,
+  // fitted to the mesh's bounding sphere; CPU: rays towards the position, stopping there).
+  virtual void light_pass(const LightSource &light, uint8_t *out) = 0;
 };
 
 // CPU reference: rays from each vertex (offset along the ray by the tolerance) against a

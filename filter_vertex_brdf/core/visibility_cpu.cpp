@@ -107,7 +107,7 @@ public:
   CpuVisibility(const MeshView &mesh, const VisibilitySettings &settings);
   const char *name() const override { return "CPU ray casting"; }
   void camera_pass(const Shot &shot, uint8_t *out) override;
-  void light_pass(const float dir_world[3], uint8_t *out) override;
+  void light_pass(const LightSource &light, uint8_t *out) override;
 
 private:
   // True when a triangle lies on the ray from `from` along unit `dir` within (0, max_dist].
@@ -257,13 +257,19 @@ void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
   }
 }
 
-void CpuVisibility::light_pass(const float dir_world[3], uint8_t *out) {
+void CpuVisibility::light_pass(const LightSource &light, uint8_t *out) {
+  const float *dir_world = light.direction.data();
   vcg::Point3f dir(dir_world[0], dir_world[1], dir_world[2]);
   const float len = dir.Norm();
-  if (!(len > 1e-12f) || !std::isfinite(len)) throw InputError("CPU visibility: the light direction is zero or not finite.");
-  dir /= len;
+  if (!light.positional && (!(len > 1e-12f) || !std::isfinite(len)))
+    throw InputError("CPU visibility: the light direction is zero or not finite.");
+  if (light.positional)
+    for (float c : light.position)
+      if (!std::isfinite(c)) throw InputError("CPU visibility: the light position is not finite.");
+  if (!light.positional) dir /= len;
   // Any occluder lies within the bounding box, hence within one diagonal of the vertex.
   const float max_dist = 2 * diagonal_ + tolerance_;
+  const vcg::Point3f light_pos(light.position[0], light.position[1], light.position[2]);
   const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
 #pragma omp parallel
   {
@@ -273,7 +279,19 @@ void CpuVisibility::light_pass(const float dir_world[3], uint8_t *out) {
     for (ptrdiff_t v = 0; v < n; ++v) {
       const float *p = mesh_.positions + 3 * v;
       const vcg::Point3f pos(p[0], p[1], p[2]);
-      out[v] = blocked(marks, pos + dir * tolerance_, dir, max_dist) ? 0 : 1;
+      if (!light.positional) {
+        out[v] = blocked(marks, pos + dir * tolerance_, dir, max_dist) ? 0 : 1;
+        continue;
+      }
+      // Towards the point light, up to it (geometry beyond the light casts no shadow).
+      vcg::Point3f to_light = light_pos - pos;
+      const float dist = to_light.Norm();
+      if (!(dist > tolerance_)) {
+        out[v] = 1;
+        continue;
+      }
+      to_light /= dist;
+      out[v] = blocked(marks, pos + to_light * tolerance_, to_light, std::min(dist, max_dist) - tolerance_) ? 0 : 1;
     }
   }
 }

@@ -12,6 +12,7 @@
 
 #include "errors.h"
 #include "gl_api.h"
+#include "light_view.h"
 
 namespace vbrdf {
 
@@ -91,7 +92,7 @@ public:
   ~GlVisibility() override;
   const char *name() const override { return "OpenGL"; }
   void camera_pass(const Shot &shot, uint8_t *out) override;
-  void light_pass(const float dir_world[3], uint8_t *out) override;
+  void light_pass(const LightSource &light, uint8_t *out) override;
 
 private:
   void check_target_size(int width, int height, const std::string &what) const;
@@ -337,39 +338,19 @@ void GlVisibility::camera_pass(const Shot &shot, uint8_t *out) {
   }
 }
 
-void GlVisibility::light_pass(const float dir_world[3], uint8_t *out) {
-  const double len = std::sqrt(double(dir_world[0]) * dir_world[0] + double(dir_world[1]) * dir_world[1] +
-                               double(dir_world[2]) * dir_world[2]);
-  if (!(len > 1e-12) || !std::isfinite(len))
-    throw InputError("OpenGL visibility: the light direction is zero or not finite.");
+// The shadow map from the light (light_view.h: orthographic for a directional light, a perspective
+// frustum fitted to the bounding sphere for a point light), then every vertex against it.
+void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
   if (mesh_.vertex_count == 0) return;
-  const float d[3] = {float(dir_world[0] / len), float(dir_world[1] / len), float(dir_world[2] / len)};
-
-  // Light frame: z towards the light (GL looks along -z), x/y any orthonormal pair.
-  const int a = std::fabs(d[0]) < 0.6f ? 0 : (std::fabs(d[1]) < 0.6f ? 1 : 2);
-  float helper[3] = {0, 0, 0};
-  helper[a] = 1;
-  float x[3] = {helper[1] * d[2] - helper[2] * d[1], helper[2] * d[0] - helper[0] * d[2],
-                helper[0] * d[1] - helper[1] * d[0]};
-  const float xl = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-  for (float &c : x) c /= xl;
-  const float y[3] = {d[1] * x[2] - d[2] * x[1], d[2] * x[0] - d[0] * x[2], d[0] * x[1] - d[1] * x[0]};
-
-  // The bounding sphere is centred on origin_, so the view is a pure rotation of the uploaded
-  // positions; orthographic over the sphere, with light-space depth in [-r, r].
-  const float r = std::max(radius_ * 1.01f + tolerance_, 1e-12f);
-  Mat4 view, projection;
-  for (int k = 0; k < 3; ++k) {
-    view.at(0, k) = x[k];
-    view.at(1, k) = y[k];
-    view.at(2, k) = d[k];
+  LightView lv;
+  try {
+    lv = make_light_view(light, origin_, radius_ * 1.01f + tolerance_);
+  } catch (const InputError &e) {
+    throw InputError(std::string("OpenGL visibility: ") + e.what());
   }
-  view.at(3, 3) = 1;
-  projection.at(0, 0) = 1 / r;
-  projection.at(1, 1) = 1 / r;
-  projection.at(2, 2) = -1 / r;
-  projection.at(3, 3) = 1;
-
+  Mat4 view, projection;
+  std::copy(lv.view, lv.view + 16, view.m);
+  std::copy(lv.projection, lv.projection + 16, projection.m);
   const int size = settings_.shadow_map_size;
   {
     GlStateGuard guard(gl_);
@@ -377,18 +358,19 @@ void GlVisibility::light_pass(const float dir_world[3], uint8_t *out) {
     ensure_target(light_target_, size, size, "the light-view shadow map");
     render_depth(light_target_, view, projection, "the light-view shadow map pass");
   }
-
   const float *map = depth_.data();
-  const float tol = tolerance_, scale = 0.5f * size / r;
+  const float tol = tolerance_;
   const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
 #pragma omp parallel for schedule(static)
   for (ptrdiff_t v = 0; v < n; ++v) {
     const float *p = mesh_.positions + 3 * v;
     const float local[3] = {p[0] - origin_[0], p[1] - origin_[1], p[2] - origin_[2]};
-    const float lx = x[0] * local[0] + x[1] * local[1] + x[2] * local[2];
-    const float ly = y[0] * local[0] + y[1] * local[1] + y[2] * local[2];
-    const float depth = -(d[0] * local[0] + d[1] * local[1] + d[2] * local[2]);
-    out[v] = depth_clear(map, size, size, lx * scale + 0.5f * size, ly * scale + 0.5f * size, depth, tol) ? 1 : 0;
+    float wx, wy, depth;
+    if (!light_view_project(lv, local, size, wx, wy, depth)) {
+      out[v] = 1;  // behind a point light: nothing between it and the light
+      continue;
+    }
+    out[v] = depth_clear(map, size, size, wx, wy, depth, tol) ? 1 : 0;
   }
 }
 

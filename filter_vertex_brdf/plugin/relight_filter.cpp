@@ -10,6 +10,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/light_file.h"
+#include "core/light_source.h"
 #include "core/output_ply.h"
 #include "core/pipeline.h"
 #include "core/project.h"
@@ -212,9 +213,9 @@ void render_novel_view(vbrdf::RelightRenderer &renderer, const RasterSet &set, c
   const vbrdf::Bounds b = vbrdf::compute_bounds(mesh.view());
   const float pivot[3] = {0.5f * (b.min[0] + b.max[0]), 0.5f * (b.min[1] + b.max[1]), 0.5f * (b.min[2] + b.max[2])};
   const vbrdf::Shot shot = vbrdf::orbit_shot(base.shot, pivot, s.azimuth, s.elevation, s.distance_scale);
-  float light_world[3];
-  vbrdf::camera_to_world_direction(shot, s.novel_light, light_world);
-  const vbrdf::RelitImage image = renderer.render(shot, light_world);
+  std::array<float, 3> light_world;
+  vbrdf::camera_to_world_direction(shot, s.novel_light, light_world.data());
+  const vbrdf::RelitImage image = renderer.render(shot, vbrdf::LightSource::directional(light_world));
   const std::string path = vbrdf::join_path(s.output_folder, "novel_view.png");
   for (const vbrdf::Raster &r : set.rasters)
     if (r.image_path == path)
@@ -332,13 +333,15 @@ void RelightFilter::apply(FilterRun &run) const {
   s.output_folder =
       s.output_folder.empty() ? default_output_folder(set.project) : resolve_path(s.output_folder, project);
   s.output.folder = s.output_folder;
-  std::vector<std::array<float, 3>> lights;
+  std::vector<vbrdf::LightSource> lights;
   if (s.render_rasters) {
     if (set.light_file.empty())
       throw vbrdf::InputError("No light file (.lp) beside '" + set.project +
                               "' or its photos has an entry for every rendered raster: set 'lightFile' to the .lp "
                               "of the rendered rasters.");
-    lights = vbrdf::resolve_light_directions(set.rasters, set.light_file);
+    const vbrdf::MeshView view = arrays.data.view();
+    lights = vbrdf::resolve_lights(set.rasters, set.light_file,
+                                   vbrdf::light_placement_of(view.positions, view.vertex_count, 0.0f, 0.0f));
   }
 
   GlContextScope gl(run.gl_context, log);

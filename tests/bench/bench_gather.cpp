@@ -46,7 +46,8 @@ int main(int argc, char **argv) {
   }
   const Project project = read_project(argv[1]);
   const MeshData mesh = load_mesh_ply(project.mesh_path);
-  const auto all_lights = resolve_light_directions(project.rasters, find_default_light_file(project.rasters, project.project_path));
+  const auto all_lights =
+      resolve_lights(project.rasters, find_default_light_file(project.rasters, project.project_path), LightPlacement());
   if (photo_counts.empty()) photo_counts.push_back(int(project.rasters.size()));
   test::OsMesaContext context;
   if (header) std::printf("backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples\n");
@@ -55,7 +56,7 @@ int main(int argc, char **argv) {
     for (int count : photo_counts) {
       const size_t p = std::min(size_t(count), project.rasters.size());
       std::vector<Raster> rasters(project.rasters.begin(), project.rasters.begin() + long(p));
-      std::vector<std::array<float, 3>> lights(all_lights.begin(), all_lights.begin() + long(p));
+      std::vector<LightSource> lights(all_lights.begin(), all_lights.begin() + long(p));
       const double t0 = now();
       auto vis = b == "gl" ? make_gl_visibility(mesh.view(), context.get_proc_address(), VisibilitySettings())
                            : make_cpu_visibility(mesh.view(), VisibilitySettings());

@@ -7,12 +7,17 @@
 // scored samples and seen vertices have no model. With --training, per-pixel PTM and
 // Relight-style RBF baselines are fitted at each vertex's pixel on the training photos of the same
 // camera (plain bilinear, shadowed kept, saturated dropped) and scored on the same samples.
-//   vbrdf_eval --result fit.ply --project heldout/project.mlp [--lp heldout/lights.lp]
+//   vbrdf_eval --result fit.ply --project heldout/project.mlp [--lp heldout/lights.lp|.json|.dome]
+//              [--dome-radius R] [--light-unit-scale S]
 //              [--photo-dir DIR] [--visibility gl|cpu]
 //              [--training train/project.mlp [--training-lp L] [--training-photo-dir DIR]]
 //              [--gt-visible gt_vertex.ply]
 //              [--max-mean-de X] [--max-p95-de Y] [--max-clean-mean-de X] [--max-clean-p95-de Y]
 //              [--below-baselines]
+// --lp / --training-lp: any light file the fit reads (light_source.h: .lp directions, .json
+//   positions, Relight .dome); --dome-radius / --light-unit-scale as the fit's domeRadius /
+//   lightUnitScale. Point lights: the product predicts with their fall-off; the per-pixel baselines
+//   use one direction per photo (from the object's centre), as RTI tools do.
 // --photo-dir / --training-photo-dir: take each raster's photo (same file name) from DIR instead
 //   (e.g. 16-bit linear/).
 // --predict: how the product predicts a held-out sample. render (default): as the camera records
@@ -51,14 +56,14 @@ using namespace vbrdf;
 namespace {
 struct Photos {
   Project project;
-  std::vector<std::array<float, 3>> lights;
+  std::vector<LightSource> lights;
 };
 
-Photos load_photos(const std::string &mlp, std::string lp, const std::string &photo_dir) {
+Photos load_photos(const std::string &mlp, std::string lp, const std::string &photo_dir, const LightPlacement &placement) {
   Photos p{read_project(mlp), {}};
   if (p.project.rasters.empty()) throw InputError(mlp + " has no raster");
   if (lp.empty()) lp = find_default_light_file(p.project.rasters, p.project.project_path);
-  p.lights = resolve_light_directions(p.project.rasters, lp);
+  p.lights = resolve_lights(p.project.rasters, lp, placement);
   if (!photo_dir.empty())
     for (Raster &r : p.project.rasters) r.image_path = join_path(photo_dir, file_name_of(r.image_path));
   return p;
@@ -113,6 +118,7 @@ int main(int argc, char **argv) {
   std::string result_path, mlp, lp, photo_dir, backend = "gl", train_mlp, train_lp, train_photo_dir, gt_path,
       gt_lit_path, predict = "render";
   double max_mean = -1, max_p95 = -1, max_clean_mean = -1, max_clean_p95 = -1;
+  float dome_radius = 0, light_unit_scale = 0;
   bool below_baselines = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -129,6 +135,8 @@ int main(int argc, char **argv) {
     else if (a == "--project") mlp = v;
     else if (a == "--lp") lp = v;
     else if (a == "--photo-dir") photo_dir = v;
+    else if (a == "--dome-radius") dome_radius = std::stof(v);
+    else if (a == "--light-unit-scale") light_unit_scale = std::stof(v);
     else if (a == "--visibility") backend = v;
     else if (a == "--training") train_mlp = v;
     else if (a == "--training-lp") train_lp = v;
@@ -147,6 +155,7 @@ int main(int argc, char **argv) {
   }
   if (result_path.empty() || mlp.empty() || (below_baselines && train_mlp.empty())) {
     std::cerr << "usage: vbrdf_eval --result fit.ply --project heldout/project.mlp [--lp F] [--photo-dir D]\n"
+                 "                  [--dome-radius R] [--light-unit-scale S]\n"
                  "                  [--visibility gl|cpu] [--training train.mlp [--training-lp F]\n"
                  "                  [--training-photo-dir D]] [--gt-visible gt_vertex.ply] [--gt-lit lit.txt]\n"
                  "                  [--predict render|vertex]\n"
@@ -157,13 +166,16 @@ int main(int argc, char **argv) {
   try {
     const ResultPly result = read_result_ply(result_path);
     const std::vector<VertexFit> fits = fits_from_result(result, result_path);
-    const Photos heldout = load_photos(mlp, lp, photo_dir);
+    const MeshView mesh_view = result.mesh.view();
+    const LightPlacement placement =
+        light_placement_of(mesh_view.positions, mesh_view.vertex_count, dome_radius, light_unit_scale);
+    const Photos heldout = load_photos(mlp, lp, photo_dir, placement);
     Photos training;
     RelightOptions options;
     if (!train_mlp.empty()) {
-      training = load_photos(train_mlp, train_lp, train_photo_dir);
+      training = load_photos(train_mlp, train_lp, train_photo_dir, placement);
       options.training_rasters = &training.project.rasters;
-      options.training_light_dirs_world = &training.lights;
+      options.training_lights = &training.lights;
     }
     std::vector<uint8_t> visible;
     if (!gt_path.empty()) {
@@ -189,7 +201,7 @@ int main(int argc, char **argv) {
       if (!context) context.reset(new test::OsMesaContext());
       renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address()));
       for (size_t r = 0; r < heldout.project.rasters.size(); ++r)
-        rendered.push_back(render_as_photographed(*renderer, heldout.project.rasters[r].shot, heldout.lights[r].data()));
+        rendered.push_back(render_as_photographed(*renderer, heldout.project.rasters[r].shot, heldout.lights[r]));
       options.rendered = &rendered;
     } else if (predict != "vertex") {
       throw InputError("--predict takes 'render' or 'vertex'");

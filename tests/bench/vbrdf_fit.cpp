@@ -1,5 +1,5 @@
 // vbrdf_fit: runs the filter's core pipeline on a .mlp without MeshLab (GL through OSMesa).
-//   vbrdf_fit project.mlp [--lp lights.lp] [--out result.ply] [--visibility auto|gl|cpu]
+//   vbrdf_fit project.mlp [--lp lights.lp|.json|.dome] [--dome-radius R] [--light-unit-scale S] [--out result.ply] [--visibility auto|gl|cpu]
 //             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required]
@@ -24,7 +24,7 @@ using namespace vbrdf;
 
 namespace {
 int usage() {
-  std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
+  std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--dome-radius R] [--light-unit-scale S] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
                "                 [--encoding auto|srgb|linear] [--shadow-map N] [--fit auto|gpu|cpu|off]\n"
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n";
@@ -40,6 +40,8 @@ int main(int argc, char **argv) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
     if (a == "--lp") settings.light_file = next();
+    else if (a == "--dome-radius") settings.dome_radius = std::stof(next());
+    else if (a == "--light-unit-scale") settings.light_unit_scale = std::stof(next());
     else if (a == "--out") settings.output_ply = next();
     else if (a == "--ts") settings.gather.specular_threshold = std::stof(next());
     else if (a == "--td") settings.gather.diffuse_threshold = std::stof(next());

@@ -133,7 +133,7 @@ std::string default_lp(const Project &p) {
 
 // Keeps `count` rasters (spread lights) and writes their .lp into `work`; returns its path.
 std::string subset_photos(std::vector<Raster> &rasters, const std::string &lp, size_t count, const std::string &work) {
-  const auto dirs = resolve_light_directions(rasters, lp);
+  const auto dirs = light_directions(resolve_lights(rasters, lp, LightPlacement()));
   const std::vector<LightEntry> entries = read_light_file(lp);
   std::vector<Raster> kept;
   std::vector<LightEntry> kept_lights;
@@ -263,14 +263,15 @@ void parameter_errors(const std::vector<VertexFit> &fits, const std::vector<floa
 
 struct HeldOut {
   std::vector<Raster> rasters;
-  std::vector<std::array<float, 3>> lights;
+  std::vector<LightSource> lights;
 };
 
-HeldOut load_heldout(const Args &a) {
+HeldOut load_heldout(const Args &a, const MeshData &mesh) {
   HeldOut h;
   Project p = read_project(a.get("heldout"));
   const std::string lp = a.get("heldout-lp").empty() ? default_lp(p) : a.get("heldout-lp");
-  h.lights = resolve_light_directions(p.rasters, lp);
+  const MeshView view = mesh.view();
+  h.lights = resolve_lights(p.rasters, lp, light_placement_of(view.positions, view.vertex_count, 0.0f, 0.0f));
   use_photo_dir(p.rasters, a.get("heldout-photo-dir"));
   h.rasters = p.rasters;
   return h;
@@ -282,9 +283,9 @@ HeldOut load_heldout(const Args &a) {
 // vertex's pixel, vertices without a model black) beside per-pixel PTM and Relight-style RBF fitted
 // on the training photos of the same camera and scored on the same samples (relight.h).
 void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<VertexFit> &fits,
-                      const std::vector<Raster> &training, const std::vector<std::array<float, 3>> &training_lights,
+                      const std::vector<Raster> &training, const std::vector<LightSource> &training_lights,
                       const GetProcAddressFn &get_proc, Json &out) {
-  const HeldOut h = load_heldout(a);
+  const HeldOut h = load_heldout(a, mesh);
   const auto t = Clock::now();
   RelightRenderer renderer(mesh.view(), fits, get_proc);
   RelightOutputOptions options;
@@ -299,12 +300,12 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
   out.num("relit_psnr", c.psnr_db);
   std::vector<cv::Mat> rendered;
   for (size_t r = 0; r < h.rasters.size(); ++r)
-    rendered.push_back(render_as_photographed(renderer, h.rasters[r].shot, h.lights[r].data()));
+    rendered.push_back(render_as_photographed(renderer, h.rasters[r].shot, h.lights[r]));
   auto visibility = make_gl_visibility(mesh.view(), get_proc, VisibilitySettings());
   RelightOptions ro;
   ro.rendered = &rendered;
   ro.training_rasters = &training;
-  ro.training_light_dirs_world = &training_lights;
+  ro.training_lights = &training_lights;
   const RelightStats ws = evaluate_relighting(mesh.view(), fits, h.rasters, h.lights, *visibility, ro);
   out.num("ws_samples", double(ws.samples));
   out.num("ws_mean", ws.mean_de2000);
@@ -382,8 +383,10 @@ int cmd_fit(const Args &a) {
   out.num("converged", double(r.fit_converged));
   out.num("alpha_iterations", double(r.fit_iterations));
   if (!a.get("heldout").empty())
-    evaluate_heldout(a, mesh, r.fits, input.rasters, resolve_light_directions(input.rasters, r.light_file), get_proc,
-                     out);
+    evaluate_heldout(a, mesh, r.fits, input.rasters,
+                     resolve_lights(input.rasters, r.light_file,
+                                    light_placement_of(mesh.view().positions, mesh.view().vertex_count, 0.0f, 0.0f)),
+                     get_proc, out);
   if (!a.get("gt").empty()) {
     std::vector<float> n_specular;
     for (const VertexAttribute &attr : r.attributes)

@@ -143,7 +143,7 @@ TEST(Project, ReadsSharedSceneLikeMeshLab) {
     EXPECT_EQ(r.height(), 480);
   }
   // Every raster's light from the scene's own .lp resolves, in world coordinates.
-  const auto dirs = resolve_light_directions(p.rasters, test::shared_dir() + "/scenes/spot_dir24/lights.lp");
+  const auto dirs = resolve_lights(p.rasters, test::shared_dir() + "/scenes/spot_dir24/lights.lp", LightPlacement());
   ASSERT_EQ(dirs.size(), 24u);
 }
 

@@ -45,13 +45,13 @@ TEST(Relight, PerfectModelScoresZeroAndWrongModelDoesNot) {
   auto visibility = make_cpu_visibility(scene.mesh.view(), VisibilitySettings());
   const size_t n = scene.mesh.positions.size() / 3;
   std::vector<VertexFit> good(n, diffuse_fit(rho));
-  const RelightStats s = evaluate_relighting(scene.mesh.view(), good, {scene.raster}, {scene.light}, *visibility);
+  const RelightStats s = evaluate_relighting(scene.mesh.view(), good, {scene.raster}, {LightSource::directional(scene.light)}, *visibility);
   ASSERT_GT(s.samples, 50u);
   EXPECT_LT(s.mean_de2000, 0.05);
   EXPECT_GT(s.psnr_db, 60.0);
   const float wrong_rho[3] = {0.3f, 0.4f, 0.2f};
   std::vector<VertexFit> wrong(n, diffuse_fit(wrong_rho));
-  const RelightStats w = evaluate_relighting(scene.mesh.view(), wrong, {scene.raster}, {scene.light}, *visibility);
+  const RelightStats w = evaluate_relighting(scene.mesh.view(), wrong, {scene.raster}, {LightSource::directional(scene.light)}, *visibility);
   EXPECT_GT(w.mean_de2000, 5.0);
   EXPECT_LT(w.psnr_db, 25.0);
   EXPECT_EQ(w.per_raster_samples[0], w.samples);
@@ -77,7 +77,7 @@ TEST(Relight, UnmodelledVerticesCountAsBlackAndFilterRestricts) {
     modelled[v] = 0;
   }
   fits[1].status = 4;  // any status other than kFitNone counts as modelled
-  const RelightStats s = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {scene.light}, *visibility);
+  const RelightStats s = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {LightSource::directional(scene.light)}, *visibility);
   ASSERT_GT(s.samples, 50u);
   EXPECT_GT(s.unmodelled_samples, s.samples / 4);
   EXPECT_LT(s.unmodelled_samples, s.samples / 2);
@@ -91,14 +91,14 @@ TEST(Relight, UnmodelledVerticesCountAsBlackAndFilterRestricts) {
 
   RelightOptions only_modelled;
   only_modelled.vertex_filter = &modelled;
-  const RelightStats f = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {scene.light}, *visibility,
+  const RelightStats f = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {LightSource::directional(scene.light)}, *visibility,
                                              only_modelled);
   EXPECT_EQ(f.samples, s.samples - s.unmodelled_samples);
   EXPECT_LT(f.mean_de2000, 0.05);
   EXPECT_EQ(f.seen_unmodelled_vertices, 0u);
   std::vector<uint8_t> wrong_size(n - 1, 1);
   only_modelled.vertex_filter = &wrong_size;
-  EXPECT_THROW(evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {scene.light}, *visibility, only_modelled),
+  EXPECT_THROW(evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {LightSource::directional(scene.light)}, *visibility, only_modelled),
                InputError);
 }
 
@@ -137,8 +137,9 @@ TEST(Relight, BaselinesScoreTheSameSamples) {
   fits[0] = VertexFit{};  // one vertex without a model
   RelightOptions options;
   options.training_rasters = &training;
-  options.training_light_dirs_world = &training_lights;
-  const RelightStats s = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {scene.light}, *visibility, options);
+  const std::vector<LightSource> training_sources = directional_lights(training_lights);
+  options.training_lights = &training_sources;
+  const RelightStats s = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {LightSource::directional(scene.light)}, *visibility, options);
   ASSERT_TRUE(s.has_baselines);
   ASSERT_GT(s.samples, 50u);
   EXPECT_EQ(s.baseline_excluded, 0u);
@@ -158,8 +159,9 @@ TEST(Relight, BaselinesScoreTheSameSamples) {
   std::vector<Raster> only_other{other};
   std::vector<std::array<float, 3>> only_other_light{{{0, 1, 0}}};
   options.training_rasters = &only_other;
-  options.training_light_dirs_world = &only_other_light;
-  const RelightStats e = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {scene.light}, *visibility, options);
+  const std::vector<LightSource> only_other_source = directional_lights(only_other_light);
+  options.training_lights = &only_other_source;
+  const RelightStats e = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {LightSource::directional(scene.light)}, *visibility, options);
   EXPECT_EQ(e.baseline_excluded, e.samples);
   EXPECT_EQ(e.ptm.samples, 0u);
   EXPECT_EQ(e.samples, s.samples);

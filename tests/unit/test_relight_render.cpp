@@ -76,7 +76,7 @@ TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
   float light[3] = {0.3f, 1.0f, 0.4f};
   const float len = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
   for (float &c : light) c /= len;
-  const RelitImage r = renderer.render(shot, light);
+  const RelitImage r = renderer.render(shot, LightSource::directional({{light[0], light[1], light[2]}}));
   ASSERT_EQ(r.width, kW);
   ASSERT_EQ(r.height, kH);
   EXPECT_EQ(count_class(r, kRelitShadowed), 0u);
@@ -115,7 +115,7 @@ TEST(RelightRender, CastShadowsAndUnfittedVertices) {
   const Shot shot = test::make_look_at_shot(eye, target, up, 200, 320, 240);
   RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
   const float s = std::sqrt(0.5f), light[3] = {s, s, 0};
-  const RelitImage r = renderer.render(shot, light);
+  const RelitImage r = renderer.render(shot, LightSource::directional({{light[0], light[1], light[2]}}));
   auto class_at = [&](float x, float z) {
     const float w[3] = {x, 0.0f, z};
     const ImagePoint p = project_to_image(shot, w);
@@ -129,7 +129,7 @@ TEST(RelightRender, CastShadowsAndUnfittedVertices) {
   EXPECT_NEAR(pixel(r, int(q.x), int(q.y))[0], 0.5f * s, 1e-3f);  // rho N.L
   // Light from below: everything faces away.
   const float below[3] = {0, -1, 0};
-  const RelitImage dark = renderer.render(shot, below);
+  const RelitImage dark = renderer.render(shot, LightSource::directional({{below[0], below[1], below[2]}}));
   EXPECT_EQ(count_class(dark, kRelitLit), 0u);
   EXPECT_EQ(count_class(dark, kRelitShadowed) + count_class(dark, kRelitNoFit),
             size_t(320 * 240) - count_class(dark, kRelitBackground));
@@ -142,8 +142,8 @@ TEST(RelightRender, RejectsMismatchedFitsAndBadLights) {
   EXPECT_THROW(RelightRenderer(mesh.view(), std::vector<VertexFit>(3), ctx->get_proc_address()), InputError);
   RelightRenderer renderer(mesh.view(), std::vector<VertexFit>(9), ctx->get_proc_address());
   const float zero[3] = {0, 0, 0};
-  EXPECT_THROW(renderer.render(top_camera(), zero), InputError);
-  EXPECT_THROW(renderer.render(Shot(), std::array<float, 3>{{0, 1, 0}}.data()), InputError);
+  EXPECT_THROW(renderer.render(top_camera(), LightSource::directional({{zero[0], zero[1], zero[2]}})), InputError);
+  EXPECT_THROW(renderer.render(Shot(), LightSource::directional({{0, 1, 0}})), InputError);
 }
 
 // A flat plane lit head on: its photo is rho everywhere on the plane (16-bit linear PNG).
@@ -176,7 +176,7 @@ TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
   std::vector<VertexFit> fits;
   FlatScene scene(rho, rho, fits);
   RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address());
-  const RelightReport good = relight_rasters(renderer, {scene.raster}, {scene.light}, RelightOutputOptions());
+  const RelightReport good = relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, RelightOutputOptions());
   ASSERT_EQ(good.rows.size(), 1u);
   const PixelComparison &c = good.rows[0].comparison;
   EXPECT_GT(c.pixels, 2000u);
@@ -188,21 +188,21 @@ TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
   EXPECT_NE(good.color_log.back().find("no usable chart"), std::string::npos) << good.color_log.back();
   RelightOutputOptions required;
   required.color_correction = RelightColorCorrection::Required;
-  EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {scene.light}, required), InputError);
+  EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, required), InputError);
   RelightOutputOptions corners;
   corners.chart_corners = {1, 2, 3};
-  EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {scene.light}, corners), InputError);
+  EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, corners), InputError);
   RelightOutputOptions off;
   off.color_correction = RelightColorCorrection::Off;
-  EXPECT_TRUE(relight_rasters(renderer, {scene.raster}, {scene.light}, off).color_log.empty());
+  EXPECT_TRUE(relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, off).color_log.empty());
   // Silhouette pixels are never compared: fewer pixels than the plane covers.
-  const RelitImage r = renderer.render(scene.raster.shot, scene.light.data());
+  const RelitImage r = renderer.render(scene.raster.shot, LightSource::directional(scene.light));
   EXPECT_LT(c.pixels, count_class(r, kRelitLit));
 
   std::vector<VertexFit> wrong_fits;
   FlatScene other(rho, wrong, wrong_fits);
   RelightRenderer wrong_renderer(other.mesh.view(), wrong_fits, ctx->get_proc_address());
-  const RelightReport bad = relight_rasters(wrong_renderer, {other.raster}, {other.light}, RelightOutputOptions());
+  const RelightReport bad = relight_rasters(wrong_renderer, {other.raster}, {LightSource::directional(other.light)}, RelightOutputOptions());
   const double expected = delta_e2000_linear_srgb(wrong, rho);
   EXPECT_NEAR(bad.rows[0].comparison.mean_de2000, expected, 0.05);
   EXPECT_NEAR(bad.rows[0].comparison.p95_de2000, expected, 0.05);
@@ -254,7 +254,7 @@ TEST(RelightRender, WritesImagesContactSheetAndTable) {
   options.folder = scene.dir + "/out/nested";
   Raster second = scene.raster;
   second.label = "second";
-  const RelightReport report = relight_rasters(renderer, {scene.raster, second}, {scene.light, scene.light}, options);
+  const RelightReport report = relight_rasters(renderer, {scene.raster, second}, {LightSource::directional(scene.light), LightSource::directional(scene.light)}, options);
   ASSERT_EQ(report.files.size(), 4u);
   for (const std::string &f : report.files) EXPECT_TRUE(file_exists(f)) << f;
   EXPECT_EQ(file_name_of(report.files[0]), "relight_000_held_out__1.png");
@@ -285,11 +285,11 @@ TEST(RelightRender, WritesImagesContactSheetAndTable) {
   over.folder = scene.dir;
   Raster clash = scene.raster;
   clash.image_path = scene.dir + "/contact_sheet.png";
-  EXPECT_THROW(relight_rasters(renderer, {clash}, {scene.light}, over), InputError);
+  EXPECT_THROW(relight_rasters(renderer, {clash}, {LightSource::directional(scene.light)}, over), InputError);
   Raster missing = scene.raster;
   missing.image_path = scene.dir + "/nope.png";
   try {
-    relight_rasters(renderer, {missing}, {scene.light}, RelightOutputOptions());
+    relight_rasters(renderer, {missing}, {LightSource::directional(scene.light)}, RelightOutputOptions());
     FAIL();
   } catch (const InputError &e) {
     EXPECT_NE(std::string(e.what()).find("held out, 1"), std::string::npos) << e.what();

@@ -25,6 +25,11 @@ struct Fixture {
   }
   Sample sample(const float p[3], const float n[3], const float l[3], bool cam = true, bool light = true) {
     Sample s;
+    make_sample(p, n, raster, 3, LightSource::directional({{l[0], l[1], l[2]}}), photo, cam, light, settings, s);
+    return s;
+  }
+  Sample sample(const float p[3], const float n[3], const LightSource &l, bool cam = true, bool light = true) {
+    Sample s;
     make_sample(p, n, raster, 3, l, photo, cam, light, settings, s);
     return s;
   }
@@ -47,7 +52,7 @@ TEST(Samples, HeadOnLightIsHighlightAndColourIsDecoded) {
 
 TEST(Samples, DiffuseGrazingAndShadowFlags) {
   Fixture f;
-  const float side60[3] = {0.8660254f, 0, 0.5f};  // N.L = 0.5 exactly at the threshold: not grazing
+  const LightSource side60 = LightSource::directional({{0.8660254f, 0, 0.5f}});  // N.L = 0.5 exactly at the threshold: not grazing
   Sample s = f.sample(kOrigin, kFacing, side60);
   EXPECT_EQ(s.flags, 0) << s.flags;
   EXPECT_NEAR(s.n_dot_l, 0.5, 1e-6);
@@ -75,7 +80,7 @@ TEST(Samples, SaturatedPixelIsFlagged) {
   Fixture f;
   // Image pixel (10,10) is white. Find the world point projecting onto its centre: x = (10.5-32)/500*10.
   const float p[3] = {(10.5f - 32) / 50.0f, (24 - 10.5f) / 50.0f, 0};
-  const float side60[3] = {0.8660254f, 0, 0.5f};
+  const LightSource side60 = LightSource::directional({{0.8660254f, 0, 0.5f}});
   const Sample s = f.sample(p, kFacing, side60);
   EXPECT_TRUE(s.flags & kSaturated);
   EXPECT_FALSE(is_diffuse_sample(s));
@@ -106,7 +111,7 @@ TEST(Samples, GatherStreamsChunksInVertexOrder) {
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   uint32_t next = 0;
   size_t total = 0;
-  const GatherStats stats = gather_samples(mesh.view(), rasters, lights, masks, settings, cache, [&](const SampleChunk &c) {
+  const GatherStats stats = gather_samples(mesh.view(), rasters, directional_lights(lights), masks, settings, cache, [&](const SampleChunk &c) {
     EXPECT_EQ(c.first_vertex, next);
     next += c.vertex_count;
     total += c.samples.size();
@@ -146,7 +151,7 @@ TEST(Samples, RimFootprintsUseTheirOwnSurfaceTexels) {
   Fixture f;
   // Image point (11.0, 11.0): footprint texels (10,10) white [bit 0], (11,10), (10,11), (11,11).
   const float p[3] = {(11.0f - 32) / 50.0f, (24 - 11.0f) / 50.0f, 0};
-  const float side60[3] = {0.8660254f, 0, 0.5f};
+  const LightSource side60 = LightSource::directional({{0.8660254f, 0, 0.5f}});
   Sample own{}, plain{}, none{};
   make_sample(p, kFacing, f.raster, 0, side60, f.photo, true, true, f.settings, own, 0xE);  // white texel not own
   EXPECT_EQ(own.flags, kRimFootprint);

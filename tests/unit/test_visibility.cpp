@@ -230,8 +230,7 @@ std::vector<uint8_t> run_camera(VisibilityBackend &b, const MeshData &m, const S
 
 std::vector<uint8_t> run_light(VisibilityBackend &b, const MeshData &m, V3 dir) {
   std::vector<uint8_t> out(vertex_count(m), 7);
-  const float d[3] = {float(dir.x), float(dir.y), float(dir.z)};
-  b.light_pass(d, out.data());
+  b.light_pass(LightSource::directional({{float(dir.x), float(dir.y), float(dir.z)}}), out.data());
   expect_all_written(out, b.name());
   return out;
 }
