@@ -99,6 +99,53 @@ TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
   EXPECT_LT(worst, 2e-3);
 }
 
+// A point light close over the plane: per pixel its own direction and the inverse-square fall-off
+// (light_source.h), the same numbers as the CPU's light_direction_at / light_irradiance_at.
+TEST(RelightRender, PointLightHasPerPixelDirectionAndFallOff) {
+  REQUIRE_GL(ctx);
+  const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
+  const float rho[3] = {0.5f, 0.3f, 0.1f};
+  const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
+  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
+  const Shot shot = top_camera();
+  LightSource light;
+  light.positional = true;
+  light.position = {{0.6f, 3.2f, -0.3f}};  // 3.2 above a plate of half-width 2: directions vary by ~60 degrees
+  light.reference_distance = 3.2f;
+  light.intensity = 0.8f;
+  const RelitImage r = renderer.render(shot, light);
+  size_t checked = 0;
+  double worst = 0, brightest = 0, darkest = 1e9;
+  for (int y = 2; y < kH - 2; y += 3)
+    for (int x = 2; x < kW - 2; x += 3) {
+      if (pixel_class(r, x, y) != kRelitLit) continue;
+      const vcg::Point3f p = plane_point(shot, x, y), e = (shot.GetViewPoint() - p).Normalize();
+      const float pf[3] = {p[0], p[1], p[2]};
+      float l[3];
+      light_direction_at(light, pf, l);
+      const vcg::Point3f n(0, 1, 0), lv(l[0], l[1], l[2]);
+      const float d = n * lv;
+      const vcg::Point3f refl = n * (2 * d) - lv;
+      float expected[3];
+      evaluate_phong(fits[0], d, refl * e, expected);
+      const float irradiance = light_irradiance_at(light, pf);
+      for (int c = 0; c < 3; ++c) {
+        expected[c] *= irradiance;
+        worst = std::max(worst, double(std::fabs(pixel(r, x, y)[c] - expected[c])));
+      }
+      brightest = std::max(brightest, double(pixel(r, x, y)[0])), darkest = std::min(darkest, double(pixel(r, x, y)[0]));
+      ++checked;
+    }
+  EXPECT_GT(checked, 500u);
+  EXPECT_LT(worst, 3e-3);
+  EXPECT_GT(brightest, 1.5 * darkest);  // the fall-off and the changing N.L are really there
+  // The fall-off itself: inverse square of the distance, 1 x intensity at the reference distance.
+  const float at_ref[3] = {0.6f, 0.0f, -0.3f}, twice[3] = {0.6f, -3.2f, -0.3f};
+  EXPECT_NEAR(light_irradiance_at(light, at_ref), 0.8f, 1e-6f);
+  EXPECT_NEAR(light_irradiance_at(light, twice), 0.2f, 1e-6f);
+  EXPECT_TRUE(std::isfinite(light_irradiance_at(light, light.position.data())));
+}
+
 TEST(RelightRender, CastShadowsAndUnfittedVertices) {
   REQUIRE_GL(ctx);
   // Ground plane plus a small plate at height 1 over the origin; light from +x, 45 degrees up:
