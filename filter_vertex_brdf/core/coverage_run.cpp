@@ -643,7 +643,7 @@ CoverageNeeds coverage_needs(const std::vector<CoverageCounts> &counts, const fl
 }
 
 void prediction_failures(const MeshView &mesh, const std::vector<uint8_t> &classes, const Viewpoint &viewpoint,
-                         const std::vector<std::array<float, 3>> &lights_world, const LightSuggestionSettings &s,
+                         const std::vector<LightSource> &lights, const LightSuggestionSettings &s,
                          std::vector<uint16_t> &diffuse, std::vector<uint16_t> &specular) {
   const size_t n = mesh.vertex_count;
   diffuse.assign(n, 0);
@@ -660,7 +660,8 @@ void prediction_failures(const MeshView &mesh, const std::vector<uint8_t> &class
     unit_normal(mesh.normals + 3 * v, nrm);
     int fails = 0;
     for (size_t r : viewpoint.rasters) {
-      const float *l = lights_world[r].data();
+      float l[3];
+      light_direction_at(lights[r], mesh.positions + 3 * v, l);  // a point light's direction at the vertex
       fails += covers_unit(need_d ? CoverageKind::Diffuse : CoverageKind::Specular, nrm, e, l, s);
     }
     (need_d ? diffuse : specular)[v] = uint16_t(std::min(fails, 65535));
@@ -726,16 +727,23 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
     throw InputError("No light file (.lp) beside the project or the photos has an entry for every raster: set "
                      "'lightFile', or add the new photos' lights." + why);
   }
+  // An .lp may hold entries for photos not imported yet (an acquisition in progress); light-position
+  // files (.json, .dome) and a dome radius go through the fit's resolve_lights.
   std::vector<std::string> unused;
-  const auto lights = lights_for_rasters(input.rasters, r.light_file, &unused);
-  log("Lights: " + std::to_string(lights.size()) + " directions from '" + r.light_file + "'" +
+  const LightPlacement placement =
+      light_placement_of(mesh.positions, mesh.vertex_count, settings.dome_radius, settings.light_unit_scale);
+  const std::string ext = r.light_file.size() >= 3 ? r.light_file.substr(r.light_file.size() - 3) : "";
+  const bool plain_lp = placement.dome_radius <= 0 && (ext == ".lp" || ext == ".LP");
+  const std::vector<LightSource> sources =
+      plain_lp ? directional_lights(lights_for_rasters(input.rasters, r.light_file, &unused))
+               : resolve_lights(input.rasters, r.light_file, placement);
+  log("Lights: " + describe_lights(sources, placement) + " from '" + r.light_file + "'" +
       (unused.empty() ? std::string(".") : " (" + std::to_string(unused.size()) + " entries for photos not imported yet)."));
 
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
   for (const Raster &raster : input.rasters) photos.get(raster.image_path, raster.width(), raster.height());
 
   auto t = Clock::now();
-  const std::vector<LightSource> sources = directional_lights(lights);
   const VisibilityMasks masks = compute_visibility(mesh, input.rasters, sources, visibility,
                                                    [&](float f, const char *s) { return !progress || progress(0.45f * f, s); });
   r.seconds_visibility = seconds_since(t);
@@ -760,7 +768,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   }
   const Viewpoint &vp = r.viewpoints[r.viewpoint];
   std::vector<uint16_t> fail_d, fail_s;
-  prediction_failures(mesh, r.classes, vp, lights, settings.suggest, fail_d, fail_s);
+  prediction_failures(mesh, r.classes, vp, sources, settings.suggest, fail_d, fail_s);
   for (size_t v = 0; v < n; ++v) r.failed_diffuse += fail_d[v] > 0, r.failed_specular += fail_s[v] > 0;
   const CoverageNeeds needs = coverage_needs(r.counts, input.dq.empty() ? nullptr : input.dq.data(),
                                              input.sq.empty() ? nullptr : input.sq.data(), settings, fail_d.data(),
@@ -769,7 +777,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   std::vector<std::vector<uint8_t>> visible;
   for (const Viewpoint &viewpoint : r.viewpoints) visible.push_back(viewpoint_visible(masks, viewpoint));
   std::vector<std::array<float, 3>> taken;  // the lights of this viewpoint's photos
-  for (size_t i : vp.rasters) taken.push_back(lights[i]);
+  for (size_t i : vp.rasters) taken.push_back(sources[i].direction);  // suggestions are directions (from the object's centre)
   if (settings.write_files && settings.learn_from_previous)
     r.followed = followed_suggestions(settings.suggestion_file.empty() ? default_suggestion_path(input.project_path)
                                                                        : settings.suggestion_file,

@@ -18,6 +18,7 @@
 #include "camera.h"
 #include "coverage.h"
 #include "light_file.h"
+#include "light_source.h"
 #include "mesh_view.h"
 #include "pipeline.h"
 #include "samples.h"
@@ -63,7 +64,9 @@ struct CoverageSettings {
   // since, its recommended light counts as followed, i.e. as a light whose promises are checked
   // (suggest_light_learning), together with the lights followed before. Needs write_files.
   bool learn_from_previous = true;
-  std::string light_file;           // "" = find_default_light_file (light_file.h)
+  std::string light_file;           // "" = find_default_light_file (light_file.h); .json / .dome: light_source.h
+  float dome_radius = 0;            // as FitSettings: the .lp's directions as point lights on a dome
+  float light_unit_scale = 0;       // as FitSettings: mesh units per unit of the light file's positions
   std::string suggestion_file;      // "" = <project folder>/<project name>_next_light.txt
   bool write_files = true;          // false: nothing is written (result only)
 };
@@ -131,7 +134,7 @@ CoverageNeeds coverage_needs(const std::vector<CoverageCounts> &counts, const fl
 // (light_covers_diffuse / light_covers_specular) says covers it while the vertex still lacks
 // that kind of sample (class kSeenNotDiffuse / kDiffuseNoSpecular); 0 elsewhere.
 void prediction_failures(const MeshView &mesh, const std::vector<uint8_t> &classes, const Viewpoint &viewpoint,
-                         const std::vector<std::array<float, 3>> &lights_world, const LightSuggestionSettings &s,
+                         const std::vector<LightSource> &lights, const LightSuggestionSettings &s,
                          std::vector<uint16_t> &diffuse, std::vector<uint16_t> &specular);
 
 // Why a vertex can only be covered from a new viewpoint.

@@ -105,7 +105,7 @@ int main(int argc, char **argv) {
 
     auto t = Clock::now();
     std::vector<uint16_t> fd, fs;
-    prediction_failures(view, classes, vp, lights, settings.suggest, fd, fs);
+    prediction_failures(view, classes, vp, directional_lights(lights), settings.suggest, fd, fs);
     const CoverageNeeds needs = coverage_needs(counts, nullptr, nullptr, settings, fd.data(), fs.data());
     const double t_needs = since(t);
     t = Clock::now();
