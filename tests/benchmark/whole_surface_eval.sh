@@ -8,7 +8,9 @@
 #     BUILD_DIR  default build/release (holding tests/bench/vbrdf_fit and vbrdf_eval)
 #     WORK_DIR   default $BUILD_DIR/whole_surface_eval (fit results and logs)
 #   environment: VBRDF_SHARED_DIR (default <repo>/../shared; VBRDF_SHARED is still read), SCENES (default the three below),
-#                VBRDF_FIT_OPTIONS (extra vbrdf_fit options, e.g. "--visibility cpu")
+#                VBRDF_FIT_OPTIONS (extra vbrdf_fit options, e.g. "--visibility cpu"),
+#                LIGHT_POSITIONS (default on: a scene with lights_world.json, i.e. point lights, is fitted and
+#                scored with those positions; off: with the directions of its lights.lp, as an RTI user would)
 #   e.g. extra options "--below-baselines" make a scene fail unless the product beats both baselines.
 # Skips (exit 0, with a message) when the shared scenes are absent (a plain clone has none).
 # Exit status: 0 all scenes ran (and met any bound given), 1 a scene failed.
@@ -18,7 +20,7 @@ build=${1:-$repo/build/release}
 work=${2:-$build/whole_surface_eval}
 [ $# -ge 2 ] && shift 2 || shift $#
 shared=${VBRDF_SHARED_DIR:-${VBRDF_SHARED:-$repo/../shared}}
-scenes=${SCENES:-"spot_dir24 bunny_two_materials_dir32 teapot_dir16"}
+scenes=${SCENES:-"spot_dir24 bunny_two_materials_dir32 teapot_dir16 teapot_point16"}
 fit=$build/tests/bench/vbrdf_fit
 eval_tool=$build/tests/bench/vbrdf_eval
 
@@ -39,9 +41,17 @@ for scene in $scenes; do
   fi
   out=$work/$scene
   mkdir -p "$out"
-  echo "== $scene"
+  fit_lights=""
+  eval_lights=""
+  if [ -f "$s/lights_world.json" ] && [ "${LIGHT_POSITIONS:-on}" != off ]; then
+    fit_lights="--lp $s/lights_world.json"
+    eval_lights="--lp $s/heldout/lights_world.json --training-lp $s/lights_world.json"
+    echo "== $scene (point lights at the positions of lights_world.json)"
+  else
+    echo "== $scene"
+  fi
   # shellcheck disable=SC2086
-  if ! "$fit" "$s/project.mlp" --photo-dir "$s/linear" --color-correction off --out "$out/fit.ply" \
+  if ! "$fit" "$s/project.mlp" --photo-dir "$s/linear" --color-correction off --out "$out/fit.ply" $fit_lights \
        ${VBRDF_FIT_OPTIONS:-} > "$out/fit.log" 2>&1; then
     echo "FAIL: vbrdf_fit on $scene (see $out/fit.log)"
     status=1
@@ -61,7 +71,7 @@ with open(sys.argv[2], "w") as f:
 PY
   # shellcheck disable=SC2086
   "$eval_tool" --result "$out/fit.ply" --project "$s/heldout/project.mlp" --photo-dir "$s/heldout/linear" \
-      --training "$s/project.mlp" --training-photo-dir "$s/linear" --gt-visible "$s/gt_vertex.ply" $lit_opt "$@" \
+      --training "$s/project.mlp" --training-photo-dir "$s/linear" --gt-visible "$s/gt_vertex.ply" $lit_opt $eval_lights "$@" \
       > "$out/eval.log" 2>&1
   rc=$?
   cat "$out/eval.log"
