@@ -17,6 +17,51 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// --- Constants of detect_spheres (lengths in full-resolution image pixels unless said) ---------
+// Bright spots: the brightest local maxima of each photo, where a mirror sphere's highlight is.
+constexpr double kSpotMinPeak = 0.2;        // a spot is at least this bright (fraction of full scale)
+constexpr int kSpotsPerPhoto = 3;           // spots kept per photo (the highlight, plus the object's)
+constexpr int kSpotMinSeparationPx = 2;     // spots closer than max(this, min radius) are one
+constexpr double kSpotInsideRadii = 0.97;   // a spot within this fraction of the radius is inside
+// Hough circles on the reduced max and median images (pixels of the reduced image).
+constexpr int kHoughMinRegionPx = 8;              // smaller search regions are skipped
+constexpr double kHoughMinRadiusPx = 2;           // smallest radius searched
+constexpr double kHoughStretchExponent = 0.25;    // fourth root: a dark sphere's faint glow shows
+constexpr double kHoughWhitePercentile = 0.99;    // this percentile maps to white (whole image)
+constexpr double kHoughTrackWhitePercentile = 0.9;  // ... near the highlight track (a small region)
+constexpr float kHoughMinWhiteLevel = 1e-3f;      // the white level of a black image
+constexpr double kHoughBlurSigmaPx = 1.5;         // blur before Canny
+constexpr double kHoughMinCentreDistancePx = 4;   // closest centres (or the smallest radius)
+constexpr double kHoughCannyThreshold = 40;       // upper Canny threshold (8-bit)
+constexpr double kHoughAccumulatorThreshold = 20; // votes a circle needs
+constexpr size_t kHoughMaxCircles = 12;           // strongest circles kept per search
+// Around the highlight track (the smallest circle holding most photos' spots).
+constexpr double kTrackReachRadii = 5;    // Hough search region: track radius times this ...
+constexpr double kTrackReachPx = 20;      // ... plus this
+constexpr double kOutermostGapPx = 1;     // outermost-edge search starts this far outside the track
+constexpr double kOutermostReachRadii = 4;  // ... and ends at track radius times this ...
+constexpr double kOutermostReachPx = 10;    // ... plus this
+// Outline edges (make_edge_image) of the full-resolution max and median images.
+constexpr double kEdgeExponent = 0.25;  // fourth root, as for Hough
+constexpr double kEdgeSigmaPx = 1.0;    // gradient blur
+// Refinement and plausibility of a candidate.
+constexpr double kRefineShiftMinPx = 2;      // the outline is searched within max(this, ...
+constexpr double kRefineShiftRadii = 0.15;   // ... this fraction of the radius) of the candidate
+constexpr double kMinOutlineCoverage = 0.5;  // the outline shows on at least this fraction of its length
+constexpr size_t kMinPhotosWithSpots = 3;    // with fewer photos with spots, the outline score decides
+constexpr size_t kMinSupportTenths = 7;      // a sphere holds a spot in 70 % of the photos with spots ...
+constexpr size_t kMinSupportPhotos = 3;      // ... and in at least this many
+constexpr double kBorderTolerancePx = 1.0;   // a sphere may touch the image border by this much
+// Merging duplicates: centres within this fraction of the smaller radius, radii within this one.
+constexpr double kSameSphereCentreRadii = 0.5;
+constexpr double kSameSphereRadiusRadii = 0.3;
+constexpr double kOuterOutlineMinScore = 0.6;  // the outer outline wins unless below this of the inner's score
+// Nested candidates: the inner one is dropped when the outer one, with as much support, has at
+// least this fraction of its score (the inner one is the edge of the highlight cloud).
+constexpr double kNestedOuterMinScore = 0.3;
+constexpr double kNestedSlackPx = 1;      // "inside" allows this much overlap
+constexpr double kFinalRefineShiftPx = 2.0;  // refine_sphere's search range for the final outline
+
 double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 void normalize3(double v[3]) {
@@ -751,180 +796,206 @@ SphereModel refine_sphere(const cv::Mat &gray, const SphereCamera &cam, const Sp
   return model_of(cam, p);
 }
 
-std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load, const SphereCamera &cam,
-                                           const SphereSearch &search, std::vector<std::string> &log) {
-  std::vector<DetectedSphere> found;
-  if (count == 0) return found;
+namespace {
 
-  // Pass 1: (reduced) max and median images, brightest spot of every photo.
-  cv::Mat max_img;
+// --- detect_spheres, step by step ------------------------------------------------------------------
+
+// Pass 1 over the photos: the (reduced) max and median images and every photo's brightest spots.
+struct PhotoSummary {
+  cv::Mat max_img, median_img;                  // at `scale` of the photos
+  std::vector<std::vector<cv::Point2d>> spots;  // brightest spots per photo, full resolution
+  int width = 0, height = 0;                    // of the photos
+  double scale = 1;                             // reduced / full size (1: not reduced)
+};
+
+PhotoSummary summarize_photos(size_t count, const GrayLoader &load, const SphereSearch &search) {
+  PhotoSummary s;
+  s.spots.resize(count);
   std::vector<cv::Mat> median_stack;
-  std::vector<std::vector<cv::Point2d>> spots(count);  // brightest spots per photo, full resolution
   const size_t median_every = std::max<size_t>(1, count / size_t(std::max(1, search.max_median_photos)));
-  int width = 0, height = 0;
-  double scale = 1;
-  const double min_r = search.min_radius_px;
   for (size_t i = 0; i < count; ++i) {
     cv::Mat g = load(i);
     if (g.empty()) continue;
-    if (width == 0) {
-      width = g.cols;
-      height = g.rows;
-      scale = std::min(1.0, double(search.detect_size) / std::max(width, height));
-    } else if (g.cols != width || g.rows != height) {
+    if (s.width == 0) {
+      s.width = g.cols;
+      s.height = g.rows;
+      s.scale = std::min(1.0, double(search.detect_size) / std::max(s.width, s.height));
+    } else if (g.cols != s.width || g.rows != s.height) {
       throw InputError("Sphere detection: photo " + std::to_string(i + 1) +
                        " has a different size from the first photo of the viewpoint");
     }
     // Spots at full resolution: a small highlight would fade in the reduced image.
-    for (const auto &p : bright_spots(g, 0.2, 3, std::max(2, int(min_r)))) spots[i].push_back(p);
-    if (scale < 1) cv::resize(g, g, cv::Size(), scale, scale, cv::INTER_AREA);
-    if (max_img.empty()) max_img = g.clone();
-    else max_img = cv::max(max_img, g);
+    const int separation = std::max(kSpotMinSeparationPx, int(search.min_radius_px));
+    for (const auto &p : bright_spots(g, kSpotMinPeak, kSpotsPerPhoto, separation)) s.spots[i].push_back(p);
+    if (s.scale < 1) cv::resize(g, g, cv::Size(), s.scale, s.scale, cv::INTER_AREA);
+    if (s.max_img.empty()) s.max_img = g.clone();
+    else s.max_img = cv::max(s.max_img, g);
     if (i % median_every == 0 && median_stack.size() < size_t(search.max_median_photos)) median_stack.push_back(g);
   }
-  if (max_img.empty()) return found;
-  const cv::Mat med_img = median_image(median_stack);
-  median_stack.clear();
+  if (!s.max_img.empty()) s.median_img = median_image(median_stack);
+  return s;
+}
 
-  const double max_r = search.max_radius_px > 0 ? search.max_radius_px : 0.5 * std::min(width, height);
-
-  // Candidates (full-resolution coordinates).
-  std::vector<Candidate> cands;
-  // HoughCircles on (a region of) a reduced image. Fourth root, then a high percentile to white:
-  // a dark sphere on a dark ground keeps an outline Canny can see; the highlights clip, which
-  // does not matter for the outline.
-  auto add_hough = [&](const cv::Mat &img, cv::Rect roi, double percentile, double r_lo, double r_hi,
-                       const std::string &source, bool from_track) {
-    roi &= cv::Rect(0, 0, img.cols, img.rows);
-    if (roi.width < 8 || roi.height < 8 || r_hi * scale < 2) return;
-    cv::Mat s, u8;
-    cv::pow(cv::max(img(roi), 0.0), 0.25, s);
-    std::vector<float> v(s.begin<float>(), s.end<float>());
-    const size_t k = size_t(percentile * double(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + long(k), v.end());
-    s.convertTo(u8, CV_8U, 255.0 / std::max(1e-3f, v[k]));
-    cv::GaussianBlur(u8, u8, cv::Size(0, 0), 1.5);
-    std::vector<cv::Vec3f> circles;
-    cv::HoughCircles(u8, circles, cv::HOUGH_GRADIENT, 1, std::max(4.0, r_lo * scale), 40, 20,
-                     int(std::max(2.0, r_lo * scale)), int(std::ceil(r_hi * scale)));
-    for (size_t n = 0; n < circles.size() && n < 12; ++n) {
-      Candidate c;
-      // Hough returns pixel-index centres; image pixels put centres at +0.5.
-      c.model = sphere_from_circle(cam, SphereCircle{(roi.x + circles[n][0] + 0.5) / scale,
-                                                     (roi.y + circles[n][1] + 0.5) / scale, circles[n][2] / scale});
-      if (!(c.model.circle.r > 0)) continue;
-      c.hough = !from_track;
-      c.track = from_track;
-      c.sources = {source};
-      cands.push_back(c);
-    }
-  };
-  const cv::Rect whole(0, 0, max_img.cols, max_img.rows);
-  add_hough(med_img, whole, 0.99, min_r, max_r, "Hough on the median image", false);
-  add_hough(max_img, whole, 0.99, min_r, max_r, "Hough on the max image", false);
-
-  // Around the track of the highlights (a dark sphere's outline is too faint to win in the whole
-  // image): the sphere contains the track, so search circles just larger than it, stretching the
-  // contrast of that region only.
-  SphereCircle tc;
-  const bool have_track = track_circle(spots, max_r, tc);
-  if (have_track) {
-    const double reach = std::min(max_r, 5 * tc.r + 20);
-    const cv::Rect roi(int((tc.x - reach) * scale), int((tc.y - reach) * scale), int(2 * reach * scale) + 1,
-                       int(2 * reach * scale) + 1);
-    const double r_lo = std::max(min_r, tc.r);
-    add_hough(med_img, roi, 0.9, r_lo, reach, "highlight track (Hough near the highlights, median image)", true);
-    add_hough(max_img, roi, 0.9, r_lo, reach, "highlight track (Hough near the highlights, max image)", true);
-  }
-
-  // Pass 2 (only when the search ran on reduced photos): the max image at full resolution.
-  cv::Mat full_max = max_img, full_med = med_img;
-  if (scale < 1) {
-    full_max.release();
-    for (size_t i = 0; i < count; ++i) {
-      cv::Mat g = load(i);
-      if (g.empty()) continue;
-      if (full_max.empty()) full_max = g.clone();
-      else full_max = cv::max(full_max, g);
-    }
-    cv::resize(med_img, full_med, full_max.size(), 0, 0, cv::INTER_LINEAR);
-  }
-  const EdgeImage edges_max = make_edge_image(full_max, 0.25, 1.0), edges_med = make_edge_image(full_med, 0.25, 1.0);
-
-  if (have_track) {
-    // ... and the outermost circular edge around the track's own centre.
-    const double r = outermost_radius(edges_max, cam, tc.x, tc.y, std::max(min_r, tc.r + 1),
-                                      std::min(max_r, 4 * tc.r + 10));
+// HoughCircles on (a region of) a reduced image, radii in [r_lo, r_hi] full-resolution pixels,
+// appended to `out` in full-resolution coordinates. Fourth root, then a high percentile to white:
+// a dark sphere on a dark ground keeps an outline Canny can see; the highlights clip, which does
+// not matter for the outline.
+void add_hough_candidates(const cv::Mat &img, double scale, cv::Rect roi, double percentile, double r_lo,
+                          double r_hi, const SphereCamera &cam, const std::string &source, bool from_track,
+                          std::vector<Candidate> &out) {
+  roi &= cv::Rect(0, 0, img.cols, img.rows);
+  if (roi.width < kHoughMinRegionPx || roi.height < kHoughMinRegionPx || r_hi * scale < kHoughMinRadiusPx) return;
+  cv::Mat s, u8;
+  cv::pow(cv::max(img(roi), 0.0), kHoughStretchExponent, s);
+  std::vector<float> v(s.begin<float>(), s.end<float>());
+  const size_t k = size_t(percentile * double(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + long(k), v.end());
+  s.convertTo(u8, CV_8U, 255.0 / std::max(kHoughMinWhiteLevel, v[k]));
+  cv::GaussianBlur(u8, u8, cv::Size(0, 0), kHoughBlurSigmaPx);
+  std::vector<cv::Vec3f> circles;
+  cv::HoughCircles(u8, circles, cv::HOUGH_GRADIENT, 1, std::max(kHoughMinCentreDistancePx, r_lo * scale),
+                   kHoughCannyThreshold, kHoughAccumulatorThreshold, int(std::max(kHoughMinRadiusPx, r_lo * scale)),
+                   int(std::ceil(r_hi * scale)));
+  for (size_t n = 0; n < circles.size() && n < kHoughMaxCircles; ++n) {
     Candidate c;
-    c.model = sphere_from_circle(cam, SphereCircle{tc.x, tc.y, r});
-    if (c.model.circle.r > 0) {
-      c.track = true;
-      c.sources = {"highlight track (outermost edge)"};
-      cands.push_back(c);
-    }
+    // Hough returns pixel-index centres; image pixels put centres at +0.5.
+    c.model = sphere_from_circle(cam, SphereCircle{(roi.x + circles[n][0] + 0.5) / scale,
+                                                   (roi.y + circles[n][1] + 0.5) / scale, circles[n][2] / scale});
+    if (!(c.model.circle.r > 0)) continue;
+    c.hough = !from_track;
+    c.track = from_track;
+    c.sources = {source};
+    out.push_back(c);
   }
+}
 
-  // Refine every candidate to its strongest outline, score it, merge duplicates.
-  std::vector<Candidate> kept;
-  for (Candidate &c : cands) {
-    double s_max = 0, s_med = 0;
-    const double shift = std::max(2.0, 0.15 * c.model.circle.r);
-    const SphereModel a = refine_on(edges_max, cam, c.model, shift, &s_max);
-    const SphereModel b = refine_on(edges_med, cam, c.model, shift, &s_med);
-    c.model = s_max >= s_med ? a : b;
-    c.score = std::max(s_max, s_med);
-    c.on_median = s_max < s_med;
-    c.coverage = edge_coverage(c.on_median ? edges_med : edges_max, cam, c.model);
-    const SphereCircle &cc = c.model.circle;
-    if (cc.r < min_r || cc.r > max_r) continue;
-    // A sphere holds a bright spot in (nearly) every photo; other round things do not.
-    c.support = 0;
-    size_t with_spots = 0;
-    for (const auto &ps : spots) {
-      with_spots += ps.empty() ? 0 : 1;
-      for (const auto &p : ps)
-        if (std::hypot(p.x - cc.x, p.y - cc.y) < 0.97 * cc.r) {
-          ++c.support;
-          break;
-        }
-    }
-    const bool plausible =
-        c.coverage >= 0.5 && (with_spots >= 3 ? c.support >= int(std::max<size_t>(3, (with_spots * 7 + 9) / 10))
-                                              : c.score >= search.min_edge_score);
-    if (!plausible) continue;
-    if (!circle_inside(cc, width, height, 1.0)) {
-      log.push_back(fmt("Sphere candidate at (%.1f, %.1f), radius %.1f px rejected: the image border cuts it. "
-                        "Move the sphere fully into the frame, or set its centre and radius manually.",
-                        cc.x, cc.y, cc.r));
-      continue;
-    }
-    bool merged = false;
-    for (Candidate &k : kept) {
-      const SphereCircle &kc = k.model.circle;
-      if (std::hypot(kc.x - cc.x, kc.y - cc.y) < 0.5 * std::min(kc.r, cc.r) &&
-          std::fabs(kc.r - cc.r) < 0.3 * std::min(kc.r, cc.r)) {
-        // Same sphere: the outline is the outermost of the two unless clearly weaker (the
-        // inner one is then shading or the edge of the highlight cloud).
-        const bool replace = cc.r > kc.r ? c.score >= 0.6 * k.score : k.score < 0.6 * c.score;
-        if (replace) {
-          k.model = c.model;
-          k.score = c.score;
-          k.support = c.support;
-          k.on_median = c.on_median;
-          k.coverage = c.coverage;
-        }
-        k.sources.insert(c.sources.begin(), c.sources.end());
-        k.hough = k.hough || c.hough;
-        k.track = k.track || c.track;
-        merged = true;
+// Hough candidates in the whole median and max images, then around the track of the highlights
+// (a dark sphere's outline is too faint to win in the whole image): the sphere contains the track,
+// so circles just larger than it are searched, stretching the contrast of that region only.
+std::vector<Candidate> hough_candidates(const PhotoSummary &s, const SphereCamera &cam, double min_r, double max_r,
+                                        bool have_track, const SphereCircle &track) {
+  std::vector<Candidate> cands;
+  const cv::Rect whole(0, 0, s.max_img.cols, s.max_img.rows);
+  add_hough_candidates(s.median_img, s.scale, whole, kHoughWhitePercentile, min_r, max_r, cam,
+                       "Hough on the median image", false, cands);
+  add_hough_candidates(s.max_img, s.scale, whole, kHoughWhitePercentile, min_r, max_r, cam, "Hough on the max image",
+                       false, cands);
+  if (!have_track) return cands;
+  const double reach = std::min(max_r, kTrackReachRadii * track.r + kTrackReachPx);
+  const double scale = s.scale;
+  const cv::Rect roi(int((track.x - reach) * scale), int((track.y - reach) * scale), int(2 * reach * scale) + 1,
+                     int(2 * reach * scale) + 1);
+  const double r_lo = std::max(min_r, track.r);
+  add_hough_candidates(s.median_img, scale, roi, kHoughTrackWhitePercentile, r_lo, reach, cam,
+                       "highlight track (Hough near the highlights, median image)", true, cands);
+  add_hough_candidates(s.max_img, scale, roi, kHoughTrackWhitePercentile, r_lo, reach, cam,
+                       "highlight track (Hough near the highlights, max image)", true, cands);
+  return cands;
+}
+
+// Pass 2 (only when pass 1 reduced the photos): the max image at full resolution; the median image
+// is the reduced one scaled up.
+void full_resolution_images(const PhotoSummary &s, size_t count, const GrayLoader &load, cv::Mat &full_max,
+                            cv::Mat &full_median) {
+  full_max = s.max_img;
+  full_median = s.median_img;
+  if (s.scale >= 1) return;
+  full_max.release();
+  for (size_t i = 0; i < count; ++i) {
+    cv::Mat g = load(i);
+    if (g.empty()) continue;
+    if (full_max.empty()) full_max = g.clone();
+    else full_max = cv::max(full_max, g);
+  }
+  cv::resize(s.median_img, full_median, full_max.size(), 0, 0, cv::INTER_LINEAR);
+}
+
+// The outermost circular edge around the track's own centre, as a candidate (none when its radius
+// collapses).
+void add_outermost_edge_candidate(const EdgeImage &edges_max, const SphereCamera &cam, const SphereCircle &track,
+                                  double min_r, double max_r, std::vector<Candidate> &cands) {
+  const double r = outermost_radius(edges_max, cam, track.x, track.y, std::max(min_r, track.r + kOutermostGapPx),
+                                    std::min(max_r, kOutermostReachRadii * track.r + kOutermostReachPx));
+  Candidate c;
+  c.model = sphere_from_circle(cam, SphereCircle{track.x, track.y, r});
+  if (!(c.model.circle.r > 0)) return;
+  c.track = true;
+  c.sources = {"highlight track (outermost edge)"};
+  cands.push_back(c);
+}
+
+// Photos holding a bright spot inside `c`, and photos holding any spot.
+int spot_support(const std::vector<std::vector<cv::Point2d>> &spots, const SphereCircle &c, size_t &with_spots) {
+  int support = 0;
+  with_spots = 0;
+  for (const auto &ps : spots) {
+    with_spots += ps.empty() ? 0 : 1;
+    for (const auto &p : ps)
+      if (std::hypot(p.x - c.x, p.y - c.y) < kSpotInsideRadii * c.r) {
+        ++support;
         break;
       }
-    }
-    if (!merged) kept.push_back(c);
   }
-  // Best supported first; of two nested candidates with the same support keep the outer one when
-  // its outline is clear (the inner one is the edge of the highlight cloud).
-  std::sort(kept.begin(), kept.end(), [&](const Candidate &a, const Candidate &b) {
+  return support;
+}
+
+// Refines `c` to its strongest outline in the max or the median image (whichever is clearer) and
+// scores it. True when it is a plausible sphere: radius in [min_r, max_r], round all around, and a
+// bright spot inside in most photos that have one (a sphere holds one in (nearly) every photo,
+// other round things do not) or, without spots, a clear outline.
+bool refine_and_score(Candidate &c, const EdgeImage &edges_max, const EdgeImage &edges_med, const SphereCamera &cam,
+                      const std::vector<std::vector<cv::Point2d>> &spots, double min_r, double max_r,
+                      double min_edge_score) {
+  double s_max = 0, s_med = 0;
+  const double shift = std::max(kRefineShiftMinPx, kRefineShiftRadii * c.model.circle.r);
+  const SphereModel a = refine_on(edges_max, cam, c.model, shift, &s_max);
+  const SphereModel b = refine_on(edges_med, cam, c.model, shift, &s_med);
+  c.model = s_max >= s_med ? a : b;
+  c.score = std::max(s_max, s_med);
+  c.on_median = s_max < s_med;
+  c.coverage = edge_coverage(c.on_median ? edges_med : edges_max, cam, c.model);
+  const SphereCircle &cc = c.model.circle;
+  if (cc.r < min_r || cc.r > max_r) return false;
+  size_t with_spots = 0;
+  c.support = spot_support(spots, cc, with_spots);
+  // ceil(with_spots * kMinSupportTenths / 10) in integers.
+  const size_t needed = std::max<size_t>(kMinSupportPhotos, (with_spots * kMinSupportTenths + 9) / 10);
+  return c.coverage >= kMinOutlineCoverage &&
+         (with_spots >= kMinPhotosWithSpots ? c.support >= int(needed) : c.score >= min_edge_score);
+}
+
+// Merges `c` into the candidate of `kept` that is the same sphere (close centres and radii), else
+// appends it. The merged outline is the outermost of the two unless clearly weaker (the inner one
+// is then shading or the edge of the highlight cloud).
+void merge_candidate(std::vector<Candidate> &kept, const Candidate &c) {
+  const SphereCircle &cc = c.model.circle;
+  for (Candidate &k : kept) {
+    const SphereCircle &kc = k.model.circle;
+    const double r = std::min(kc.r, cc.r);
+    if (std::hypot(kc.x - cc.x, kc.y - cc.y) >= kSameSphereCentreRadii * r ||
+        std::fabs(kc.r - cc.r) >= kSameSphereRadiusRadii * r)
+      continue;
+    const bool replace =
+        cc.r > kc.r ? c.score >= kOuterOutlineMinScore * k.score : k.score < kOuterOutlineMinScore * c.score;
+    if (replace) {
+      k.model = c.model;
+      k.score = c.score;
+      k.support = c.support;
+      k.on_median = c.on_median;
+      k.coverage = c.coverage;
+    }
+    k.sources.insert(c.sources.begin(), c.sources.end());
+    k.hough = k.hough || c.hough;
+    k.track = k.track || c.track;
+    return;
+  }
+  kept.push_back(c);
+}
+
+// Best supported first; of two nested candidates with the same support the outer one is kept when
+// its outline is clear (the inner one is the edge of the highlight cloud).
+void rank_and_drop_nested(std::vector<Candidate> &kept) {
+  std::sort(kept.begin(), kept.end(), [](const Candidate &a, const Candidate &b) {
     if (a.support != b.support) return a.support > b.support;
     return a.score > b.score;
   });
@@ -932,30 +1003,70 @@ std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load,
     for (size_t j = 0; j < kept.size(); ++j) {
       if (i == j || kept[j].score < 0) continue;
       const SphereCircle &in = kept[i].model.circle, &out = kept[j].model.circle;
-      if (kept[i].score >= 0 && in.r < out.r && std::hypot(in.x - out.x, in.y - out.y) + in.r <= out.r + 1 &&
-          kept[j].support >= kept[i].support && kept[j].score >= 0.3 * kept[i].score) {
+      if (kept[i].score >= 0 && in.r < out.r && std::hypot(in.x - out.x, in.y - out.y) + in.r <= out.r + kNestedSlackPx &&
+          kept[j].support >= kept[i].support && kept[j].score >= kNestedOuterMinScore * kept[i].score) {
         kept[j].sources.insert(kept[i].sources.begin(), kept[i].sources.end());
         kept[j].track = kept[j].track || kept[i].track;
         kept[i].score = -1;  // dropped
       }
     }
   kept.erase(std::remove_if(kept.begin(), kept.end(), [](const Candidate &c) { return c.score < 0; }), kept.end());
+}
+
+// The final sphere of a candidate: refined at full resolution (refine_sphere) in `fine`, with its
+// log line.
+DetectedSphere detected_sphere(const Candidate &c, const cv::Mat &fine, const SphereCamera &cam, size_t count) {
+  DetectedSphere d;
+  d.model = refine_sphere(fine, cam, c.model, kFinalRefineShiftPx);
+  d.method = c.hough ? SphereMethod::Hough : SphereMethod::HighlightTrack;
+  d.edge_score = c.score;
+  d.highlights_inside = c.support;
+  d.description = fmt("centre (%.2f, %.2f), radius %.2f px", d.model.circle.x, d.model.circle.y, d.model.circle.r) +
+                  fmt(", outline contrast %.2f, a bright spot inside in %.0f of %.0f photos", c.score, c.support,
+                      double(count)) +
+                  "; found by " + join(c.sources);
+  return d;
+}
+
+} // namespace
+
+std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load, const SphereCamera &cam,
+                                           const SphereSearch &search, std::vector<std::string> &log) {
+  std::vector<DetectedSphere> found;
+  if (count == 0) return found;
+  const PhotoSummary summary = summarize_photos(count, load, search);
+  if (summary.max_img.empty()) return found;
+  const double min_r = search.min_radius_px;
+  const double max_r = search.max_radius_px > 0 ? search.max_radius_px
+                                                : 0.5 * std::min(summary.width, summary.height);
+
+  SphereCircle track;
+  const bool have_track = track_circle(summary.spots, max_r, track);
+  std::vector<Candidate> cands = hough_candidates(summary, cam, min_r, max_r, have_track, track);
+  cv::Mat full_max, full_med;
+  full_resolution_images(summary, count, load, full_max, full_med);
+  const EdgeImage edges_max = make_edge_image(full_max, kEdgeExponent, kEdgeSigmaPx);
+  const EdgeImage edges_med = make_edge_image(full_med, kEdgeExponent, kEdgeSigmaPx);
+  if (have_track) add_outermost_edge_candidate(edges_max, cam, track, min_r, max_r, cands);
+
+  std::vector<Candidate> kept;
+  for (Candidate &c : cands) {
+    if (!refine_and_score(c, edges_max, edges_med, cam, summary.spots, min_r, max_r, search.min_edge_score)) continue;
+    const SphereCircle &cc = c.model.circle;
+    if (!circle_inside(cc, summary.width, summary.height, kBorderTolerancePx)) {
+      log.push_back(fmt("Sphere candidate at (%.1f, %.1f), radius %.1f px rejected: the image border cuts it. "
+                        "Move the sphere fully into the frame, or set its centre and radius manually.",
+                        cc.x, cc.y, cc.r));
+      continue;
+    }
+    merge_candidate(kept, c);
+  }
+  rank_and_drop_nested(kept);
   for (const Candidate &c : kept) {
     if (int(found.size()) >= search.max_spheres) break;
-    DetectedSphere d;
-    // Final refinement at full resolution (see refine_sphere); the median image exists at full
-    // resolution only when the photos were not reduced.
-    const cv::Mat &fine = c.on_median && scale == 1 ? full_med : full_max;
-    d.model = refine_sphere(fine, cam, c.model, 2.0);
-    d.method = c.hough ? SphereMethod::Hough : SphereMethod::HighlightTrack;
-    d.edge_score = c.score;
-    d.highlights_inside = c.support;
-    d.description = fmt("centre (%.2f, %.2f), radius %.2f px", d.model.circle.x, d.model.circle.y,
-                        d.model.circle.r) +
-                    fmt(", outline contrast %.2f, a bright spot inside in %.0f of %.0f photos", c.score,
-                        c.support, double(count)) +
-                    "; found by " + join(c.sources);
-    found.push_back(d);
+    // The median image exists at full resolution only when the photos were not reduced.
+    const cv::Mat &fine = c.on_median && summary.scale == 1 ? full_med : full_max;
+    found.push_back(detected_sphere(c, fine, cam, count));
   }
   return found;
 }

@@ -4,36 +4,23 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "filter_parameters.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
 
 namespace {
 
-// Parameter names: the .mlx scripts refer to them, never rename.
-const char *const kLightFile = "lightFile";
+// Parameter names of this filter only (the .mlx scripts refer to them, never rename); the shared
+// ones are in filter_parameters.h.
 const char *const kSuggestionFile = "suggestionFile";
-const char *const kViewpointRaster = "viewpointRaster";
-const char *const kSpecularThreshold = "specularThreshold";
-const char *const kDiffuseThreshold = "diffuseThreshold";
 const char *const kMinDiffuseSamples = "minDiffuseSamples";
-const char *const kMinSpecularSamples = "minSpecularSamples";
 const char *const kMinElevation = "minLightElevation";
 const char *const kUseFitQuality = "useFitQuality";
 const char *const kPoorDiffuseQuality = "poorDiffuseQuality";
 const char *const kPoorSpecularQuality = "poorSpecularQuality";
 const char *const kColorByCoverage = "colorByCoverage";
 const char *const kSelectNewView = "selectNewViewVertices";
-const char *const kPhotoEncoding = "photoEncoding";
-const char *const kSaturationLevel = "saturationLevel";
-const char *const kVisibilityBackend = "visibilityBackend";
-const char *const kDepthTolerance = "depthTolerance";
-const char *const kShadowMapSize = "shadowMapSize";
-const char *const kMemoryBudgetMB = "memoryBudgetMB";
-
-void require(bool ok, const char *param, const std::string &what) {
-  if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
-}
 
 std::vector<vbrdf::VertexAttribute> coverage_attributes(const vbrdf::CoverageResult &r) {
   std::vector<vbrdf::VertexAttribute> attrs = {
@@ -85,28 +72,18 @@ int CoverageFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
 int CoverageFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTFLAGSELECT; }
 
 void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
-  params.addParam(RichOpenFile(
-      kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
-      "RTI light file with one line per photo (image file name and unit direction towards the light in the "
-      "camera frame). Entries for photos not imported yet are ignored. Empty: the most recently modified "
-      "*.lp beside the project or the photos that has an entry for every raster (the rule of every Vertex "
-      "BRDF filter)."));
+  shared::add_light_file(params);
   params.addParam(RichSaveFile(
       kSuggestionFile, "", "Text (*.txt)", "Suggestion file",
       "Where the suggestions are written (key: value lines, then the report); the vertices only a new "
       "viewpoint can cover go beside it (same name ending in _new_view_vertices.txt). Relative paths are "
       "relative to the project folder. Empty: the project's name followed by _next_light.txt, beside it."));
-  params.addParam(RichInt(kViewpointRaster, -1, "Viewpoint raster",
-                          "Suggestions are for the viewpoint (camera position) of this raster, counted from 0 in "
-                          "the layer list; -1: the last raster (the current camera position)."));
-  params.addParam(RichFloat(kSpecularThreshold, 0.9f, "Specular threshold (R.E)",
-                            "A lit sample with R.E above this (in (0,1]) is a highlight: specular coverage."));
-  params.addParam(RichFloat(kDiffuseThreshold, 0.5f, "Diffuse threshold (N.L)",
-                            "A lit sample needs N.L at least this (in [0,1)) to count as diffuse coverage."));
+  shared::add_viewpoint_raster(params);
+  shared::add_specular_threshold(params);
+  shared::add_diffuse_threshold(params, shared::DiffuseThresholdUse::Coverage);
   params.addParam(RichInt(kMinDiffuseSamples, 1, "Diffuse samples needed",
                           "Diffuse samples a vertex needs to count as diffusely covered."));
-  params.addParam(RichInt(kMinSpecularSamples, 1, "Specular samples needed",
-                          "Specular samples a vertex needs to count as specularly covered."));
+  shared::add_min_specular_samples(params);
   params.addParam(RichFloat(kMinElevation, 5.0f, "Lowest light elevation (deg)",
                             "Suggested lights are at least this many degrees above the camera's image plane "
                             "(in [0, 80]): lights further back would be behind the object or in the picture."));
@@ -124,39 +101,19 @@ void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &par
   params.addParam(RichBool(kSelectNewView, true, "Select vertices needing a new viewpoint",
                            "Select exactly the vertices that no photo sees or that no placeable light of any "
                            "registered viewpoint can cover."));
-  params.addParam(RichEnum(kPhotoEncoding, 0, QStringList() << "Auto" << "sRGB (8-bit)" << "Linear",
-                           "Photo encoding",
-                           "How photo values map to light (saturation test). Auto: 8-bit photos are "
-                           "sRGB-encoded, 16-bit photos linear."));
-  params.addParam(RichFloat(kSaturationLevel, 0.99f, "Saturation level",
-                            "Fraction of the maximum code value (in (0,1]) at or above which a channel counts "
-                            "as clipped; clipped samples do not count as coverage."));
-  params.addParam(RichEnum(kVisibilityBackend, 0, QStringList() << "Auto" << "GPU (OpenGL)" << "CPU (ray cast)",
-                           "Visibility",
-                           "How occlusion and cast shadows are computed. Auto: OpenGL depth passes when "
-                           "MeshLab's context supports them, else the CPU."));
-  params.addParam(RichFloat(kDepthTolerance, 0.002f, "Depth tolerance",
-                            "A vertex counts as visible (or lit) when it is at most this far behind the first "
-                            "surface along the ray, as a fraction of the bounding-box diagonal."));
-  params.addParam(RichInt(kShadowMapSize, 2048, "Shadow map size",
-                          "Resolution (pixels per side) of the depth map rendered from each light direction."));
-  params.addParam(RichInt(kMemoryBudgetMB, 2048, "Photo memory (MB)",
-                          "Decoded photos kept in memory at once; photos beyond it are reloaded when needed."));
+  shared::add_photo_and_visibility(params);
 }
 
 vbrdf::CoverageSettings CoverageFilter::settings_from(const RichParameterList &params) {
   vbrdf::CoverageSettings s;
-  s.light_file = params.getOpenFileName(kLightFile).toUtf8().toStdString();
-  s.suggestion_file = params.getSaveFileName(kSuggestionFile).toUtf8().toStdString();
-  s.viewpoint_raster = params.getInt(kViewpointRaster);
-  require(s.viewpoint_raster >= -1, kViewpointRaster, "must be -1 (the last raster) or a raster index");
-  const float specular = params.getFloat(kSpecularThreshold), diffuse = params.getFloat(kDiffuseThreshold);
-  require(specular > 0.0f && specular <= 1.0f, kSpecularThreshold, "must be in (0, 1]");
-  require(diffuse >= 0.0f && diffuse < 1.0f, kDiffuseThreshold, "must be in [0, 1)");
+  s.light_file = shared::light_file(params);
+  s.suggestion_file = utf8(params.getSaveFileName(kSuggestionFile));
+  s.viewpoint_raster = shared::viewpoint_raster(params);
+  shared::read_gather(params, s.gather);
+  shared::read_visibility(params, s.visibility_choice, s.visibility);
   s.min_diffuse = params.getInt(kMinDiffuseSamples);
-  s.min_specular = params.getInt(kMinSpecularSamples);
   require(s.min_diffuse >= 1 && s.min_diffuse <= 1000, kMinDiffuseSamples, "must be in [1, 1000]");
-  require(s.min_specular >= 1 && s.min_specular <= 1000, kMinSpecularSamples, "must be in [1, 1000]");
+  s.min_specular = shared::min_specular_samples(params);
   s.suggest.min_elevation_deg = params.getFloat(kMinElevation);
   require(s.suggest.min_elevation_deg >= 0.0f && s.suggest.min_elevation_deg <= 80.0f, kMinElevation,
           "must be in [0, 80] degrees");
@@ -164,28 +121,21 @@ vbrdf::CoverageSettings CoverageFilter::settings_from(const RichParameterList &p
   s.poor_sq = params.getFloat(kPoorSpecularQuality);
   require(s.poor_dq >= 0.0f && s.poor_dq <= 2.0f, kPoorDiffuseQuality, "must be in [0, 2]");
   require(s.poor_sq >= 0.0f && s.poor_sq <= 2.0f, kPoorSpecularQuality, "must be in [0, 2]");
-  const int encoding = params.getEnum(kPhotoEncoding);
-  require(encoding >= 0 && encoding <= 2, kPhotoEncoding, "must be 0 (Auto), 1 (sRGB) or 2 (Linear)");
-  const float saturation = params.getFloat(kSaturationLevel);
-  require(saturation > 0.0f && saturation <= 1.0f, kSaturationLevel, "must be in (0, 1]");
-  const int backend = params.getEnum(kVisibilityBackend);
-  require(backend >= 0 && backend <= 2, kVisibilityBackend, "must be 0 (Auto), 1 (GPU) or 2 (CPU)");
-  const float tolerance = params.getFloat(kDepthTolerance);
-  require(std::isfinite(tolerance) && tolerance > 0.0f && tolerance < 1.0f, kDepthTolerance, "must be in (0, 1)");
-  const int map_size = params.getInt(kShadowMapSize);
-  require(map_size >= 64 && map_size <= 16384, kShadowMapSize, "must be in [64, 16384]");
-  const int budget = params.getInt(kMemoryBudgetMB);
-  require(budget >= 16, kMemoryBudgetMB, "must be at least 16");
-
-  s.gather.specular_threshold = specular;
-  s.gather.diffuse_threshold = diffuse;
-  s.gather.encoding = vbrdf::PhotoEncoding(encoding);
-  s.gather.saturation_level = saturation;
-  s.gather.photo_cache_bytes = size_t(budget) << 20;
-  s.visibility_choice = vbrdf::VisibilityChoice(backend);
-  s.visibility.depth_tolerance = tolerance;
-  s.visibility.shadow_map_size = map_size;
   return s;
+}
+
+CoverageFilter::Display CoverageFilter::display_from(const RichParameterList &params) {
+  Display display;
+  display.color_by_class = params.getBool(kColorByCoverage);
+  display.select_new_view = params.getBool(kSelectNewView);
+  display.use_fit_quality = params.getBool(kUseFitQuality);
+  return display;
+}
+
+vbrdf::CoverageSettings CoverageFilter::default_settings() {
+  RichParameterList params;
+  CoverageFilter().initParameters(MeshDocument(), params);
+  return settings_from(params);
 }
 
 vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::CoverageSettings settings,
@@ -202,6 +152,8 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
   input.project_path = project_path(run.document, *mesh);
   settings.light_file = resolve_path(settings.light_file, input.project_path);
   settings.suggestion_file = resolve_path(settings.suggestion_file, input.project_path);
+  if (settings.viewpoint_raster < 0 && !run.document.rasterList.empty())
+    settings.viewpoint_raster = int(shared::chosen_raster(run.document, -1));  // the current raster
   if (display.use_fit_quality) {
     input.dq = vertex_float_attribute(*mesh, arrays, "dq");
     input.sq = vertex_float_attribute(*mesh, arrays, "sq");
@@ -225,10 +177,7 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
 }
 
 void CoverageFilter::apply(FilterRun &run) const {
-  Display display;
-  display.color_by_class = run.params.getBool(kColorByCoverage);
-  display.select_new_view = run.params.getBool(kSelectNewView);
-  display.use_fit_quality = run.params.getBool(kUseFitQuality);
+  const Display display = display_from(run.params);
   const vbrdf::CoverageResult r = run_on_document(run, settings_from(run.params), display);
   std::ostringstream summary;
   summary << "Vertex BRDF coverage: " << r.class_counts[vbrdf::kFullyCovered] << " fully covered, "

@@ -22,15 +22,19 @@ public:
   // Filter parameters -> core settings (paths not yet resolved). Throws vbrdf::InputError naming
   // the parameter when a value is out of range.
   static vbrdf::CoverageSettings settings_from(const RichParameterList &params);
+  // settings_from the filter's default parameters: what the photo import filter runs.
+  static vbrdf::CoverageSettings default_settings();
 
   struct Display {
     bool color_by_class = true;     // vertex colours = coverage classes
     bool select_new_view = true;    // select the vertices only a new viewpoint can cover
     bool use_fit_quality = true;    // take DQ/SQ from the mesh's "dq"/"sq" attributes when present
   };
+  // The display parameters (colorByCoverage, selectNewViewVertices, useFitQuality).
+  static Display display_from(const RichParameterList &params);
   // Runs the coverage on the current mesh and every raster of the document (paths in `settings`
-  // relative to the project folder) and stores the results in the mesh as `display` says.
-  // Throws vbrdf::InputError / ProcessingError.
+  // relative to the project folder; viewpoint_raster -1 = the document's current raster) and
+  // stores the results in the mesh as `display` says. Throws vbrdf::InputError / ProcessingError.
   static vbrdf::CoverageResult run_on_document(FilterRun &run, vbrdf::CoverageSettings settings,
                                                const Display &display);
 };

@@ -12,58 +12,43 @@
 #include "core/file_util.h"
 #include "core/light_file.h"
 #include "coverage_filter.h"
+#include "filter_parameters.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
 
 namespace {
 
-// Parameter names: the .mlx scripts refer to them, never rename.
+// Parameter names of this filter only (the .mlx scripts refer to them, never rename); the shared
+// ones are in filter_parameters.h.
 const char *const kPhotoFiles = "photoFiles";
 const char *const kPhotoFolder = "photoFolder";
 const char *const kReferenceRaster = "referenceRaster";
 const char *const kLightSource = "lightSource";
-const char *const kLightFile = "lightFile";
-const char *const kSphereX = "sphereCenterX";
-const char *const kSphereY = "sphereCenterY";
-const char *const kSphereRadius = "sphereRadius";
-const char *const kOutputLightFile = "outputLightFile";
 const char *const kUpdateCoverage = "updateCoverage";
 
 enum LightSource { kFromLightFile = 0, kFromSphere = 1 };
-
-std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
-
-void require(bool ok, const char *param, const std::string &what) {
-  if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
-}
-
-std::string canonical(const std::string &path) {
-  const QFileInfo info(QString::fromStdString(path));
-  return utf8(info.exists() ? info.canonicalFilePath() : info.absoluteFilePath());
-}
+using Settings = ImportPhotosFilter::Settings;
 
 // The photos to import: the listed files, else every new image of the folder (default: the
 // reference raster's photo folder). Photos that already are rasters are skipped.
-std::vector<std::string> photos_to_import(const RichParameterList &params, const std::vector<vbrdf::Raster> &rasters,
+std::vector<std::string> photos_to_import(const Settings &s, const std::vector<vbrdf::Raster> &rasters,
                                           const vbrdf::Raster &reference, const std::string &project,
                                           const std::function<void(const std::string &)> &log) {
-  const QString list = params.getString(kPhotoFiles).trimmed();
-  if (list.isEmpty()) {
-    std::string folder = resolve_path(utf8(params.getString(kPhotoFolder).trimmed()), project);
+  if (s.photo_files.empty()) {
+    std::string folder = resolve_path(s.photo_folder, project);
     if (folder.empty()) folder = vbrdf::directory_of(reference.image_path);
     return vbrdf::new_photos_in_folder(folder, rasters);
   }
   std::set<std::string> taken;
-  for (const vbrdf::Raster &r : rasters) taken.insert(canonical(r.image_path));
+  for (const vbrdf::Raster &r : rasters) taken.insert(canonical_path(r.image_path));
   std::vector<std::string> photos;
-  for (QString item : list.split(QRegExp("[;\n]"), QString::SkipEmptyParts)) {
-    const std::string path = resolve_path(utf8(item.trimmed()), project);
-    if (path.empty()) continue;
+  for (const std::string &item : s.photo_files) {
+    const std::string path = resolve_path(item, project);
     if (!vbrdf::file_exists(path))
       throw vbrdf::InputError("Photo '" + path + "' (parameter '" + kPhotoFiles + "') does not exist: check the name; "
                               "relative names are relative to the project folder.");
-    if (taken.insert(canonical(path)).second) photos.push_back(path);
+    if (taken.insert(canonical_path(path)).second) photos.push_back(path);
     else log("Vertex BRDF import: '" + path + "' is already a raster; skipped.");
   }
   return photos;
@@ -95,25 +80,20 @@ std::vector<vbrdf::Raster> new_rasters(const std::vector<std::string> &photos, c
   return out;
 }
 
-std::string default_light_output(const std::string &project) {
-  const QFileInfo info(QString::fromStdString(project.empty() ? std::string("vertex_brdf") : project));
-  return utf8(QDir(info.absolutePath()).filePath(info.completeBaseName() + "_lights.lp"));
-}
-
 // Sphere mode: estimates the lights of the new photos (and of the viewpoint's rasters that have
 // none) and writes them, with every entry of the existing .lp, to the output .lp. Returns its path.
-std::string lights_from_sphere(const RichParameterList &params, const std::vector<vbrdf::Raster> &rasters,
+std::string lights_from_sphere(const Settings &s, const std::vector<vbrdf::Raster> &rasters,
                                const std::vector<vbrdf::Raster> &added, size_t reference_index,
                                const std::string &project, const std::function<void(const std::string &)> &log) {
   const vbrdf::Raster &reference = rasters[reference_index];
-  const std::string given = resolve_path(utf8(params.getOpenFileName(kLightFile)), project);
+  const std::string given = resolve_path(s.light_file, project);
   const std::string existing_lp = given.empty() ? vbrdf::find_default_light_file(rasters, project) : given;
   std::vector<vbrdf::LightEntry> existing;
   if (!existing_lp.empty()) existing = vbrdf::read_light_file(existing_lp);
-  std::string out = resolve_path(utf8(params.getSaveFileName(kOutputLightFile)), project);
-  if (out.empty()) out = default_light_output(project);
-  if (!given.empty() && canonical(out) == canonical(given))
-    throw vbrdf::InputError("Parameter '" + std::string(kOutputLightFile) + "' names the input light file '" + given +
+  std::string out = resolve_path(s.output_light_file, project);
+  if (out.empty()) out = shared::default_output_light_file(project, shared::OutputLightFileUse::Import);
+  if (!given.empty() && canonical_path(out) == canonical_path(given))
+    throw vbrdf::InputError("Parameter '" + std::string(shared::kOutputLightFile) + "' names the input light file '" + given +
                             "': choose another output so that the original stays untouched.");
 
   // The sphere is located on every photo of the viewpoint; lights are estimated where missing.
@@ -125,8 +105,7 @@ std::string lights_from_sphere(const RichParameterList &params, const std::vecto
     photos.push_back(rasters[i].image_path);
   }
   for (const vbrdf::Raster &r : added) wanted.push_back(photos.size()), photos.push_back(r.image_path);
-  const vbrdf::SphereCircle manual{params.getFloat(kSphereX), params.getFloat(kSphereY), params.getFloat(kSphereRadius)};
-  const auto entries = vbrdf::sphere_light_entries(photos, wanted, reference.shot, manual, vbrdf::directory_of(out),
+  const auto entries = vbrdf::sphere_light_entries(photos, wanted, reference.shot, s.sphere, vbrdf::directory_of(out),
                                                    [&log](const std::string &l) { log("Vertex BRDF import: " + l); });
   vbrdf::write_light_file(out, vbrdf::merge_light_entries(existing, entries));
   log("Vertex BRDF import: " + std::to_string(entries.size()) + " light(s) estimated from the sphere; wrote " + out +
@@ -136,9 +115,9 @@ std::string lights_from_sphere(const RichParameterList &params, const std::vecto
 
 // .lp mode: the given .lp, or the default one (find_default_light_file: the newest one beside the
 // project or photos that has an entry for every raster, the new photos included).
-std::string lights_from_file(const RichParameterList &params, const std::vector<vbrdf::Raster> &all,
+std::string lights_from_file(const Settings &s, const std::vector<vbrdf::Raster> &all,
                              const std::vector<vbrdf::Raster> &added, const std::string &project) {
-  const std::string given = resolve_path(utf8(params.getOpenFileName(kLightFile)), project);
+  const std::string given = resolve_path(s.light_file, project);
   if (!given.empty()) {
     vbrdf::lights_for_rasters(all, given);  // names the first raster without entry
     return given;
@@ -200,27 +179,36 @@ void ImportPhotosFilter::initParameters(const MeshDocument &, RichParameterList 
   params.addParam(RichEnum(kLightSource, kFromLightFile, QStringList() << "Light file (.lp)" << "Reflective sphere",
                            "Light directions",
                            "Light file: the .lp must have an entry for every photo. Reflective sphere: each new "
-                           "photo's light is estimated from the sphere's highlight and written to the output .lp."));
-  params.addParam(RichOpenFile(kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
-                               "The .lp with the photos' lights (sphere mode: the lights of the photos taken "
-                               "before). Empty: the most recently modified .lp beside the project or the photos "
-                               "that has an entry for every raster."));
-  params.addParam(RichFloat(kSphereX, 0.0f, "Sphere centre x (pixels)",
-                            "Sphere mode: the sphere's centre in the photo (pixels from the left edge); used "
-                            "when the radius is above 0."));
-  params.addParam(RichFloat(kSphereY, 0.0f, "Sphere centre y (pixels)",
-                            "Sphere mode: the sphere's centre in the photo (pixels from the top edge)."));
-  params.addParam(RichFloat(kSphereRadius, 0.0f, "Sphere radius (pixels)",
-                            "Sphere mode: the sphere's radius in the photo; 0: find the sphere automatically."));
-  params.addParam(RichSaveFile(kOutputLightFile, "", "Light positions (*.lp)", "Output light file",
-                               "Sphere mode: where every raster's light is written (the existing entries and the "
-                               "estimated ones). Empty: the project's name followed by _lights.lp, beside it."));
+                           "photo's light is estimated from the sphere's highlight (sphere parameters below) and "
+                           "written, with the entries of the light file (the lights of the photos taken before), "
+                           "to the output .lp."));
+  shared::add_light_file(params);
+  shared::add_sphere_outline(params);
+  shared::add_output_light_file(params, shared::OutputLightFileUse::Import);
   params.addParam(RichBool(kUpdateCoverage, true, "Update coverage",
                            "Then run \"Vertex BRDF: coverage and next light\" with its default settings: vertex "
                            "colours by coverage, suggestions in the log and beside the project."));
 }
 
+ImportPhotosFilter::Settings ImportPhotosFilter::settings_from(const RichParameterList &params) {
+  Settings s;
+  for (const QString &item : params.getString(kPhotoFiles).split(QRegExp("[;\n]"), QString::SkipEmptyParts))
+    if (!item.trimmed().isEmpty()) s.photo_files.push_back(utf8(item.trimmed()));
+  s.photo_folder = utf8(params.getString(kPhotoFolder).trimmed());
+  s.reference_raster = params.getInt(kReferenceRaster);
+  require(s.reference_raster >= -1, kReferenceRaster, "must be -1 (the last raster) or a raster index");
+  const int source = params.getEnum(kLightSource);
+  require(source == kFromLightFile || source == kFromSphere, kLightSource, "must be 0 (.lp) or 1 (sphere)");
+  s.lights_from_sphere = source == kFromSphere;
+  s.light_file = shared::light_file(params);
+  s.sphere = shared::sphere_outline(params);
+  s.output_light_file = shared::output_light_file(params);
+  s.update_coverage = params.getBool(kUpdateCoverage);
+  return s;
+}
+
 void ImportPhotosFilter::apply(FilterRun &run) const {
+  const Settings s = settings_from(run.params);
   MeshModel *mesh = run.document.mm();
   if (mesh == nullptr)
     throw vbrdf::InputError("No current mesh: open the registered mesh (or its .mlp project) first.");
@@ -229,20 +217,17 @@ void ImportPhotosFilter::apply(FilterRun &run) const {
   if (rasters.empty())
     throw vbrdf::InputError("The project has no raster: register the first photo of the viewpoint (e.g. with "
                             "Raster alignment), then import the others with this filter.");
-  const int ref = run.params.getInt(kReferenceRaster);
-  require(ref >= -1 && ref < int(rasters.size()), kReferenceRaster,
+  const int ref = s.reference_raster;
+  require(ref < int(rasters.size()), kReferenceRaster,
           "must be -1 (the last raster) or a raster index from 0 to " + std::to_string(rasters.size() - 1));
   const size_t reference_index = ref < 0 ? rasters.size() - 1 : size_t(ref);
   const vbrdf::Raster &reference = rasters[reference_index];
   if (!vbrdf::shot_is_valid(reference.shot))
     throw vbrdf::InputError("Raster '" + reference.label + "' has no valid camera: register it first, or choose a "
                             "registered raster as reference.");
-  const int source = run.params.getEnum(kLightSource);
-  require(source == kFromLightFile || source == kFromSphere, kLightSource, "must be 0 (.lp) or 1 (sphere)");
-  require(run.params.getFloat(kSphereRadius) >= 0.0f, kSphereRadius, "must be 0 (find the sphere) or positive");
 
   const std::string project = project_path(run.document, *mesh);
-  const std::vector<std::string> photos = photos_to_import(run.params, rasters, reference, project, log);
+  const std::vector<std::string> photos = photos_to_import(s, rasters, reference, project, log);
   check_sizes(photos, reference);
   const std::vector<vbrdf::Raster> added = new_rasters(photos, reference);
   std::vector<vbrdf::Raster> all = rasters;
@@ -251,15 +236,15 @@ void ImportPhotosFilter::apply(FilterRun &run) const {
   // Lights first: a failure leaves the document unchanged.
   std::string light_file;
   if (!added.empty())
-    light_file = source == kFromSphere ? lights_from_sphere(run.params, rasters, added, reference_index, project, log)
-                                       : lights_from_file(run.params, all, added, project);
+    light_file = s.lights_from_sphere ? lights_from_sphere(s, rasters, added, reference_index, project, log)
+                                      : lights_from_file(s, all, added, project);
   for (const vbrdf::Raster &r : added) add_raster(run.document, r.image_path, r.shot, r.label);
   log("Vertex BRDF import: " + std::to_string(added.size()) + " new photo(s) added with the camera of raster '" +
       reference.label + "'" + (light_file.empty() ? std::string(" (no new photo found)") : "; lights: " + light_file) +
       ". Save the project to keep them.");
 
-  if (run.params.getBool(kUpdateCoverage)) {
-    vbrdf::CoverageSettings settings;
+  if (s.update_coverage) {
+    vbrdf::CoverageSettings settings = CoverageFilter::default_settings();
     settings.light_file = light_file;  // "" = the coverage filter's own search
     CoverageFilter::run_on_document(run, settings, CoverageFilter::Display());
   }

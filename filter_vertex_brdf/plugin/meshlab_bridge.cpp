@@ -23,8 +23,6 @@ bool is_identity(const Matrix44m &m) {
   return true;
 }
 
-std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
-
 // The vertex colours the mesh had before any of our filters painted it (fit albedo, coverage
 // classes): saved once, at the first paint, so that "keep the input colour" keeps the user's
 // colours, not the previous run's.
@@ -127,6 +125,13 @@ std::string project_path(const MeshDocument &document, const MeshModel &mesh) {
     return utf8(project.absoluteFilePath());
   if (!mesh.fullName().isEmpty()) return utf8(QFileInfo(mesh.fullName()).absoluteFilePath());
   return std::string();
+}
+
+std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
+
+std::string canonical_path(const std::string &path) {
+  const QFileInfo info(QString::fromStdString(path));
+  return utf8(info.exists() ? info.canonicalFilePath() : info.absoluteFilePath());
 }
 
 std::string resolve_path(const std::string &path, const std::string &project) {

@@ -33,6 +33,13 @@ std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document);
 // default .lp search and output path). May be empty for a mesh never saved.
 std::string project_path(const MeshDocument &document, const MeshModel &mesh);
 
+// The UTF-8 bytes of a Qt string (paths and labels handed to the core).
+std::string utf8(const QString &s);
+
+// The canonical path of an existing file (links resolved), else the absolute path: for "is this
+// the same file" tests.
+std::string canonical_path(const std::string &path);
+
 // Absolute path of `path` (relative paths are taken relative to the project's folder, not to
 // the process's working directory, which meshlabserver changes while loading). "" stays "".
 std::string resolve_path(const std::string &path, const std::string &project_path);

@@ -17,16 +17,17 @@
 #include "core/relight_render.h"
 #include "core/result_ply.h"
 #include "core/result_schema.h"
+#include "filter_parameters.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
 
 namespace {
 
-// Parameter names: the .mlx scripts refer to them, never rename.
+// Parameter names of this filter only (the .mlx scripts refer to them, never rename); the shared
+// ones are in filter_parameters.h.
 const char *const kFitResultPly = "fitResultPly";
 const char *const kRasterProject = "rasterProject";
-const char *const kLightFile = "lightFile";
 const char *const kOutputFolder = "outputFolder";
 const char *const kRenderRasters = "renderRasters";
 const char *const kNovelView = "novelView";
@@ -36,49 +37,16 @@ const char *const kOrbitElevation = "orbitElevation";
 const char *const kDistanceScale = "distanceScale";
 const char *const kNovelLight = "novelLight";
 const char *const kHeatMapMax = "heatMapMax";
-const char *const kPhotoEncoding = "photoEncoding";
-const char *const kShadowMapSize = "shadowMapSize";
-const char *const kColorCorrection = "colorCorrection";
-const char *const kChartCorners = "chartCorners";
-const char *const kExposureNormalisation = "exposureNormalisation";
 
-void require(bool ok, const char *param, const std::string &what) {
-  if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
-}
+using Settings = RelightFilter::Settings;
 
-std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
+} // namespace
 
-// "x1 y1 ... x4 y4" (spaces, commas or semicolons between numbers), 8 per viewpoint; "" = detect.
-std::vector<float> parse_corners(const QString &text) {
-  QString cleaned = text;
-  cleaned.replace(',', ' ').replace(';', ' ');
-  std::vector<float> values;
-  for (const QString &word : cleaned.split(' ', QString::SkipEmptyParts)) {
-    bool ok = false;
-    const float v = word.toFloat(&ok);
-    require(ok && std::isfinite(v), kChartCorners, "must be numbers; '" + utf8(word) + "' is not a number");
-    values.push_back(v);
-  }
-  require(values.size() % 8 == 0, kChartCorners,
-          "needs 8 numbers per viewpoint (x y of 4 patch centres), got " + std::to_string(values.size()));
-  return values;
-}
-
-struct Settings {
-  std::string fit_result_ply, raster_project, light_file, output_folder;
-  bool render_rasters = true, novel_view = false;
-  int view_raster = 0;
-  float azimuth = 0, elevation = 0, distance_scale = 1;
-  float novel_light[3] = {0, 0, 1};
-  vbrdf::RelightRenderSettings render;
-  vbrdf::RelightOutputOptions output;
-};
-
-Settings settings_from(const RichParameterList &params) {
+RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &params) {
   Settings s;
   s.fit_result_ply = utf8(params.getOpenFileName(kFitResultPly));
   s.raster_project = utf8(params.getOpenFileName(kRasterProject));
-  s.light_file = utf8(params.getOpenFileName(kLightFile));
+  s.light_file = shared::light_file(params);
   s.output_folder = utf8(params.getString(kOutputFolder));
   s.render_rasters = params.getBool(kRenderRasters);
   s.novel_view = params.getBool(kNovelView);
@@ -98,21 +66,19 @@ Settings settings_from(const RichParameterList &params) {
   s.output.heat_map_max_de = params.getFloat(kHeatMapMax);
   require(std::isfinite(s.output.heat_map_max_de) && s.output.heat_map_max_de > 0 && s.output.heat_map_max_de <= 100,
           kHeatMapMax, "must be in (0, 100]");
-  const int encoding = params.getEnum(kPhotoEncoding);
-  require(encoding >= 0 && encoding <= 2, kPhotoEncoding, "must be 0 (Auto), 1 (sRGB) or 2 (Linear)");
-  s.output.encoding = vbrdf::PhotoEncoding(encoding);
-  const int color = params.getEnum(kColorCorrection);
-  require(color >= 0 && color <= 2, kColorCorrection, "must be 0 (Off), 1 (Auto) or 2 (Required)");
-  s.output.color_correction = vbrdf::RelightColorCorrection(color);  // same order as the enum's entries
-  s.output.chart_corners = parse_corners(params.getString(kChartCorners));
-  const int exposure = params.getEnum(kExposureNormalisation);
-  require(exposure >= 0 && exposure <= 2, kExposureNormalisation, "must be 0 (Auto), 1 (Off) or 2 (On)");
-  s.output.exposure = vbrdf::ExposureMode(exposure);  // same order as the enum's entries
-  s.render.shadow_map_size = params.getInt(kShadowMapSize);
-  require(s.render.shadow_map_size == 0 || (s.render.shadow_map_size >= 64 && s.render.shadow_map_size <= 16384),
-          kShadowMapSize, "must be 0 (automatic) or in [64, 16384]");
+  s.output.encoding = shared::photo_encoding(params);
+  static_assert(int(vbrdf::RelightColorCorrection::Off) == int(vbrdf::ColorCorrectionChoice::Off) &&
+                    int(vbrdf::RelightColorCorrection::Auto) == int(vbrdf::ColorCorrectionChoice::Auto) &&
+                    int(vbrdf::RelightColorCorrection::Required) == int(vbrdf::ColorCorrectionChoice::Required),
+                "relight's colour correction choices follow the fit's");
+  s.output.color_correction = vbrdf::RelightColorCorrection(int(shared::color_correction(params)));
+  s.output.chart_corners = shared::chart_corners(params);
+  s.output.exposure = shared::exposure_normalisation(params);
+  s.render.shadow_map_size = shared::shadow_map_size(params);
   return s;
 }
+
+namespace {
 
 // The fit filter's per-vertex float attributes, read by name through the result schema.
 std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays) {
@@ -266,10 +232,7 @@ void RelightFilter::initParameters(const MeshDocument &, RichParameterList &para
                                "Render the rasters of this project instead of the document's, e.g. the held-out "
                                "photos (heldout/project.mlp) to measure relighting on lights the fit never saw. "
                                "Its mesh is ignored; its cameras must be registered to the current mesh."));
-  params.addParam(RichOpenFile(kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
-                               "Light direction of each rendered raster (RTI .lp, matched by image file name). "
-                               "Empty: the most recently modified *.lp beside the project (or the raster project) or "
-                               "the rendered photos that has an entry for every one of them."));
+  shared::add_light_file(params);
   params.addParam(RichString(kOutputFolder, "", "Output folder",
                              "Where the images, contact_sheet.png and relight_table.csv are written (created if "
                              "needed; existing files of the same names are replaced). Relative paths are relative "
@@ -296,27 +259,9 @@ void RelightFilter::initParameters(const MeshDocument &, RichParameterList &para
   params.addParam(RichFloat(kHeatMapMax, 10.0f, "Heat map maximum (CIEDE2000)",
                             "Colour difference shown at the top of the heat map's colour scale (larger values are "
                             "clipped). 1 is about a just-noticeable difference. Range (0, 100]."));
-  params.addParam(RichEnum(kPhotoEncoding, 0, QStringList() << "Auto" << "sRGB (8-bit)" << "Linear",
-                           "Photo encoding",
-                           "How photo values map to light, as in the fit: Auto takes 8-bit photos as sRGB and "
-                           "16-bit photos as linear."));
-  params.addParam(RichEnum(kColorCorrection, 1, QStringList() << "Off" << "Auto (use a chart if found)" << "Required",
-                           "Colour correction",
-                           "Set it as for the fit. When the fit corrected its samples with a ColorChecker seen in "
-                           "the photos, its model predicts corrected colours: the compared photos are then "
-                           "calibrated from the chart in their own viewpoint and corrected the same way. Auto: "
-                           "viewpoints without a chart are compared as decoded. Off: never corrected."));
-  params.addParam(RichString(kChartCorners, "", "Chart corner patches (px)",
-                             "As for the fit, if the chart is not detected: centres of the dark skin, bluish green, "
-                             "black and white patches in the first photo of each rendered viewpoint, \"x1 y1 ... x4 "
-                             "y4\" (8 numbers for all viewpoints, or 8 per viewpoint). Empty: detect."));
-  params.addParam(RichEnum(kExposureNormalisation, 0,
-                           QStringList() << "Auto" << "Off (one exposure)" << "On (each photo by its chart)",
-                           "Exposure normalisation", "As for the fit: how the compared photos' brightness is "
-                           "normalised by the chart's grey patches."));
-  params.addParam(RichInt(kShadowMapSize, 0, "Shadow map size",
-                          "Resolution of the depth map rendered from the light for cast shadows. 0: automatic, as "
-                          "the fit's visibility pass (from the mesh's edge lengths). Otherwise [64, 16384]."));
+  shared::add_photo_encoding(params);
+  shared::add_color_correction(params);
+  shared::add_shadow_map_size(params);
 }
 
 void RelightFilter::apply(FilterRun &run) const {

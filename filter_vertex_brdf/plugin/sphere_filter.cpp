@@ -17,98 +17,28 @@
 #include "core/photo.h"
 #include "core/pipeline.h"
 #include "core/sphere_lights.h"
+#include "filter_parameters.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
 
 namespace {
 
-// Parameter names: the .mlx scripts refer to them, never rename. The first sphere's names are
-// those of "Vertex BRDF: import new photos of a viewpoint".
-const char *const kViewpointRaster = "viewpointRaster";
-const char *const kSphereX = "sphereCenterX";
-const char *const kSphereY = "sphereCenterY";
-const char *const kSphereRadius = "sphereRadius";
+// Parameter names of this filter only (the .mlx scripts refer to them, never rename); the shared
+// ones (the first sphere's outline among them) are in filter_parameters.h.
 const char *const kSphere2X = "sphere2CenterX";
 const char *const kSphere2Y = "sphere2CenterY";
 const char *const kSphere2Radius = "sphere2Radius";
 const char *const kSphereCount = "sphereCount";
 const char *const kSphereRadiusWorld = "sphereRadiusWorld";
-const char *const kPhotoEncoding = "photoEncoding";
-const char *const kOutputLightFile = "outputLightFile";
 
 const char *const kPrefix = "Vertex BRDF sphere: ";
 const char *const kFitFilterName = "Vertex BRDF: fit per-vertex reflectance";
-
-std::string utf8(const QString &s) { return s.toUtf8().toStdString(); }
-
-void require(bool ok, const char *param, const std::string &what) {
-  if (!ok) throw vbrdf::InputError(std::string("Parameter '") + param + "' " + what);
-}
 
 std::string fmt(const char *format, double a, double b = 0, double c = 0, double d = 0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, format, a, b, c, d);
   return buf;
-}
-
-std::string canonical(const std::string &path) {
-  const QFileInfo info(QString::fromStdString(path));
-  return utf8(info.exists() ? info.canonicalFilePath() : info.absoluteFilePath());
-}
-
-struct SphereParams {
-  int viewpoint_raster = -1;
-  std::vector<vbrdf::SphereCircle> manual;  // empty: detect
-  int sphere_count = 1;
-  double radius_world = 0;
-  vbrdf::PhotoEncoding encoding = vbrdf::PhotoEncoding::Auto;
-  std::string output;  // as given (resolved later)
-};
-
-// A manual outline: used when its radius is set (> 0).
-bool manual_circle(const RichParameterList &params, const char *x, const char *y, const char *r,
-                   vbrdf::SphereCircle &out) {
-  out = {params.getFloat(x), params.getFloat(y), params.getFloat(r)};
-  require(std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.r) && out.r >= 0, r,
-          "must be 0 (find the sphere automatically) or the sphere's radius in pixels");
-  return out.r > 0;
-}
-
-SphereParams params_from(const RichParameterList &params) {
-  SphereParams p;
-  p.viewpoint_raster = params.getInt(kViewpointRaster);
-  require(p.viewpoint_raster >= -1, kViewpointRaster, "must be -1 (the current raster) or a raster index");
-  vbrdf::SphereCircle first, second;
-  const bool has_first = manual_circle(params, kSphereX, kSphereY, kSphereRadius, first);
-  const bool has_second = manual_circle(params, kSphere2X, kSphere2Y, kSphere2Radius, second);
-  require(has_first || !has_second, kSphereRadius,
-          "must be set when the second sphere is given (set the first sphere's centre and radius too)");
-  if (has_first) p.manual.push_back(first);
-  if (has_second) p.manual.push_back(second);
-  p.sphere_count = params.getInt(kSphereCount);
-  require(p.sphere_count >= 1 && p.sphere_count <= 4, kSphereCount, "must be in [1, 4]");
-  p.radius_world = params.getFloat(kSphereRadiusWorld);
-  require(std::isfinite(p.radius_world) && p.radius_world >= 0, kSphereRadiusWorld,
-          "must be 0 (unknown) or the spheres' radius in the mesh's units");
-  const int encoding = params.getEnum(kPhotoEncoding);
-  require(encoding >= 0 && encoding <= 2, kPhotoEncoding, "must be 0 (Auto), 1 (sRGB) or 2 (Linear)");
-  p.encoding = vbrdf::PhotoEncoding(encoding);  // same order as the enum's entries
-  p.output = utf8(params.getSaveFileName(kOutputLightFile));
-  return p;
-}
-
-// The raster chosen by the parameter; -1: MeshLab's current raster (else the last one).
-size_t chosen_raster(MeshDocument &document, int param) {
-  const int count = document.rasterList.size();
-  if (param >= 0) {
-    require(param < count, kViewpointRaster,
-            "is " + std::to_string(param) + " but the project has " + std::to_string(count) +
-                " rasters (counted from 0; -1 = the current raster)");
-    return size_t(param);
-  }
-  const int current = document.rasterList.indexOf(document.rm());
-  return size_t(current >= 0 ? current : count - 1);
 }
 
 std::vector<size_t> viewpoint_of(const std::vector<vbrdf::Raster> &rasters, size_t raster) {
@@ -134,7 +64,7 @@ cv::Mat gray_of(const vbrdf::Photo &photo) {
 // Loads photo i of the viewpoint on demand (detection reads each photo once or twice, the
 // highlights once more); reports progress and honours cancellation.
 vbrdf::GrayLoader gray_loader(const std::vector<vbrdf::Raster> &rasters, const std::vector<size_t> &group,
-                              const SphereParams &p, const vbrdf::ProgressFn &progress) {
+                              const SphereFilter::Settings &p, const vbrdf::ProgressFn &progress) {
   const size_t expected = (p.manual.empty() ? 3 : 1) * group.size();
   auto loads = std::make_shared<size_t>(0);
   return [&rasters, &group, &p, progress, expected, loads](size_t i) {
@@ -147,21 +77,16 @@ vbrdf::GrayLoader gray_loader(const std::vector<vbrdf::Raster> &rasters, const s
   };
 }
 
-std::string default_output(const std::string &project) {
-  const QFileInfo info(QString::fromStdString(project.empty() ? std::string("vertex_brdf") : project));
-  return utf8(QDir(info.absolutePath()).filePath(info.completeBaseName() + "_sphere.lp"));
-}
-
 // The output must not replace the project, the mesh or a photo.
 void check_output(const std::string &out, const std::string &project, const MeshModel *mesh,
                   const std::vector<vbrdf::Raster> &rasters) {
   std::vector<std::string> inputs = {project};
   if (mesh != nullptr) inputs.push_back(utf8(mesh->fullName()));
   for (const vbrdf::Raster &r : rasters) inputs.push_back(r.image_path);
-  const std::string target = canonical(out);
+  const std::string target = canonical_path(out);
   for (const std::string &in : inputs)
-    if (!in.empty() && canonical(in) == target)
-      throw vbrdf::InputError("Parameter '" + std::string(kOutputLightFile) + "' names the input file '" + in +
+    if (!in.empty() && canonical_path(in) == target)
+      throw vbrdf::InputError("Parameter '" + std::string(shared::kOutputLightFile) + "' names the input file '" + in +
                               "': choose another .lp path so that the input stays untouched.");
 }
 
@@ -254,7 +179,7 @@ void validate_viewpoint(const std::vector<vbrdf::Raster> &rasters, const std::ve
 
 // Spheres and per-photo lights of the viewpoint, logged; InputError when no photo got a light.
 vbrdf::LightCalibration calibrate(const std::vector<vbrdf::Raster> &rasters, const std::vector<size_t> &group,
-                                  size_t chosen, const SphereParams &p, const vbrdf::ProgressFn &progress,
+                                  size_t chosen, const SphereFilter::Settings &p, const vbrdf::ProgressFn &progress,
                                   const std::function<void(const std::string &)> &log) {
   vbrdf::LightSettings settings;
   settings.manual_spheres = p.manual;
@@ -270,8 +195,8 @@ vbrdf::LightCalibration calibrate(const std::vector<vbrdf::Raster> &rasters, con
   if (cal.valid_count() == 0)
     throw vbrdf::InputError("No photo of the viewpoint of raster '" + rasters[chosen].label +
                             "' got a light: the sphere shows no highlight (see the warnings). Check the sphere's "
-                            "centre and radius (parameters '" + kSphereX + "', '" + kSphereY + "', '" +
-                            kSphereRadius + "'); nothing was written.");
+                            "centre and radius (parameters '" + shared::kSphereCenterX + "', '" +
+                            shared::kSphereCenterY + "', '" + shared::kSphereRadius + "'); nothing was written.");
   return cal;
 }
 
@@ -302,17 +227,8 @@ MeshFilterInterface::FilterClass SphereFilter::filterClass() const { return Mesh
 int SphereFilter::postConditions() const { return MeshModel::MM_NONE; }
 
 void SphereFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
-  params.addParam(RichInt(kViewpointRaster, -1, "Viewpoint raster",
-                          "Lights are estimated for the photos of this raster's viewpoint (every raster with the "
-                          "same camera), counted from 0 in the layer list; -1: the current raster."));
-  params.addParam(RichFloat(kSphereX, 0.0f, "Sphere centre x (px)",
-                            "Centre of the sphere's outline in the photos, image pixels from the left edge. Used "
-                            "with the radius below; radius 0: the sphere is found automatically."));
-  params.addParam(RichFloat(kSphereY, 0.0f, "Sphere centre y (px)",
-                            "Centre of the sphere's outline, image pixels from the top edge."));
-  params.addParam(RichFloat(kSphereRadius, 0.0f, "Sphere radius (px)",
-                            "Radius of the sphere's outline in image pixels. 0: find the sphere(s) automatically; "
-                            "> 0: use this outline (and the second sphere's, if set) and skip detection."));
+  shared::add_viewpoint_raster(params);
+  shared::add_sphere_outline(params);
   params.addParam(RichFloat(kSphere2X, 0.0f, "Second sphere centre x (px)",
                             "Optional second sphere (needs the first one set): centre x in image pixels."));
   params.addParam(RichFloat(kSphere2Y, 0.0f, "Second sphere centre y (px)",
@@ -327,16 +243,27 @@ void SphereFilter::initParameters(const MeshDocument &, RichParameterList &param
                             "Physical radius of the spheres in the mesh's units (all spheres the same size). "
                             "Only for triangulated near-light positions: given, they are logged in world "
                             "coordinates; 0: in sphere radii, camera frame."));
-  params.addParam(RichEnum(kPhotoEncoding, 0, QStringList() << "Auto" << "sRGB (8-bit)" << "Linear",
-                           "Photo encoding",
-                           "How photo values map to light. Auto: 8-bit photos are sRGB-encoded, 16-bit photos "
-                           "linear."));
-  params.addParam(RichSaveFile(
-      kOutputLightFile, "", "Light positions (*.lp)", "Output light file (.lp)",
-      "Where the light directions are written (RTI .lp: image name and unit direction towards the light, x right, "
-      "y up, z towards the camera), replacing the file atomically; entries of other viewpoints' rasters already "
-      "in it are kept. Relative paths are relative to the project folder. Empty: the project's name followed "
-      "by _sphere.lp, beside the project."));
+  shared::add_photo_encoding(params);
+  shared::add_output_light_file(params, shared::OutputLightFileUse::Sphere);
+}
+
+SphereFilter::Settings SphereFilter::settings_from(const RichParameterList &params) {
+  Settings p;
+  p.viewpoint_raster = shared::viewpoint_raster(params);
+  const vbrdf::SphereCircle first = shared::sphere_outline(params);
+  const vbrdf::SphereCircle second = shared::sphere_outline(params, kSphere2X, kSphere2Y, kSphere2Radius);
+  require(first.r > 0 || second.r == 0, shared::kSphereRadius,
+          "must be set when the second sphere is given (set the first sphere's centre and radius too)");
+  if (first.r > 0) p.manual.push_back(first);
+  if (second.r > 0) p.manual.push_back(second);
+  p.sphere_count = params.getInt(kSphereCount);
+  require(p.sphere_count >= 1 && p.sphere_count <= 4, kSphereCount, "must be in [1, 4]");
+  p.radius_world = params.getFloat(kSphereRadiusWorld);
+  require(std::isfinite(p.radius_world) && p.radius_world >= 0, kSphereRadiusWorld,
+          "must be 0 (unknown) or the spheres' radius in the mesh's units");
+  p.encoding = shared::photo_encoding(params);
+  p.output = shared::output_light_file(params);
+  return p;
 }
 
 void SphereFilter::apply(FilterRun &run) const {
@@ -344,18 +271,18 @@ void SphereFilter::apply(FilterRun &run) const {
     const bool warning = line.find("Warning") != std::string::npos;
     run.log(warning ? GLLogStream::WARNING : GLLogStream::FILTER, line);
   };
-  const SphereParams p = params_from(run.params);
+  const Settings p = settings_from(run.params);
   const std::vector<vbrdf::Raster> rasters = document_rasters(run.document);
   if (rasters.empty())
     throw vbrdf::InputError("The project has no rasters: load the registered photos of the viewpoint (File > Import "
                             "Raster) or open the .mlp.");
-  const size_t chosen = chosen_raster(run.document, p.viewpoint_raster);
+  const size_t chosen = shared::chosen_raster(run.document, p.viewpoint_raster);
   const std::vector<size_t> group = viewpoint_of(rasters, chosen);
   validate_viewpoint(rasters, group);
   const MeshModel *mesh = run.document.mm();
   const std::string project = mesh != nullptr ? project_path(run.document, *mesh) : std::string();
   std::string out = resolve_path(p.output, project);
-  if (out.empty()) out = default_output(project);
+  if (out.empty()) out = shared::default_output_light_file(project, shared::OutputLightFileUse::Sphere);
   check_output(out, project, mesh, rasters);
   log(std::string(kPrefix) + "viewpoint of raster '" + rasters[chosen].label + "': " + std::to_string(group.size()) +
       " photo(s).");

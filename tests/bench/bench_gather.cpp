@@ -2,7 +2,13 @@
 // colour) on a project, for the GL back end (OSMesa llvmpipe) and the CPU ray caster, using the
 // first P photos. Prints one CSV line per run:
 //   backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples
-//   bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header]
+//   bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header] [--passes]
+// --passes: instead, the time of one camera pass (the first raster's camera, photo size) and one
+// light pass (its light; shadow map at the automatic size the fit uses), measured on the second
+// call of each (render targets exist), after the back end's setup (upload / grid):
+//   passes,backend,vertices,width,height,shadow_map,setup_s,camera_pass_s,light_pass_s
+// (The GL visibility unit tests check these passes for correctness only: timing a shared test
+// machine makes a flaky test, so the figures live here.)
 #include <chrono>
 #include <cstdio>
 #include <sstream>
@@ -28,21 +34,44 @@ std::vector<int> parse_list(const std::string &s) {
   for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
   return out;
 }
+// One camera and one light pass, timed on their second call (see the header).
+void time_passes(const std::string &backend, const MeshData &mesh, const Raster &raster, const float light[3],
+                 test::OsMesaContext &context) {
+  const VisibilitySettings settings;  // automatic shadow-map size, as the fit
+  const double t0 = now();
+  auto vis = backend == "gl" ? make_gl_visibility(mesh.view(), context.get_proc_address(), settings)
+                             : make_cpu_visibility(mesh.view(), settings);
+  const double setup = now() - t0;
+  std::vector<uint8_t> out(mesh.positions.size() / 3);
+  vis->camera_pass(raster.shot, out.data());
+  vis->light_pass(light, out.data());
+  const double t1 = now();
+  vis->camera_pass(raster.shot, out.data());
+  const double t2 = now();
+  vis->light_pass(light, out.data());
+  const double t3 = now();
+  std::printf("passes,%s,%zu,%d,%d,%d,%.3f,%.3f,%.3f\n", backend.c_str(), mesh.positions.size() / 3, raster.width(),
+              raster.height(), resolved_shadow_map_size(mesh.view(), settings), setup, t2 - t1, t3 - t2);
+  std::fflush(stdout);
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header]\n");
+    std::fprintf(stderr, "usage: bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header] "
+                         "[--passes]\n");
     return 2;
   }
   std::string backend = "both";
   std::vector<int> photo_counts;
-  bool header = false;
+  bool header = false, passes = false;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--backend" && i + 1 < argc) backend = argv[++i];
     else if (a == "--photos" && i + 1 < argc) photo_counts = parse_list(argv[++i]);
     else if (a == "--csv-header") header = true;
+    else if (a == "--passes") passes = true;
   }
   const Project project = read_project(argv[1]);
   const MeshData mesh = load_mesh_ply(project.mesh_path);
@@ -50,6 +79,12 @@ int main(int argc, char **argv) {
       resolve_lights(project.rasters, find_default_light_file(project.rasters, project.project_path), LightPlacement());
   if (photo_counts.empty()) photo_counts.push_back(int(project.rasters.size()));
   test::OsMesaContext context;
+  if (passes) {
+    if (header) std::printf("passes,backend,vertices,width,height,shadow_map,setup_s,camera_pass_s,light_pass_s\n");
+    for (const std::string b : {std::string("gl"), std::string("cpu")})
+      if (backend == "both" || backend == b) time_passes(b, mesh, project.rasters.at(0), all_lights.at(0).data(), context);
+    return 0;
+  }
   if (header) std::printf("backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples\n");
   for (const std::string b : {std::string("gl"), std::string("cpu")}) {
     if (backend != "both" && backend != b) continue;

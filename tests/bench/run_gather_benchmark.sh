@@ -14,3 +14,5 @@ for v in 10000 30000 100000; do
 done
 "$bench" "$WORK/v100000/project.mlp" --backend both --photos 4,8,16,32 --csv-header | tee "$OUT"
 for v in 10000 30000; do "$bench" "$WORK/v$v/project.mlp" --backend both --photos 32 | tee -a "$OUT"; done
+# One camera pass (1024x768) and one light pass on 100k vertices (formerly timed in a unit test).
+"$bench" "$WORK/v100000/project.mlp" --backend both --passes --csv-header | tee "${OUT%.csv}_passes.csv"

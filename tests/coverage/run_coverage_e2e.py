@@ -156,10 +156,16 @@ def cmd_dump(a):
     return report(failures)
 
 
-def independent_classes(mlp, ts=0.9, td=0.5):
+def mlx_values(mlx):
+    """{parameter name: value string} of a filter script."""
+    return {p.get("name"): p.get("value") for p in ET.parse(mlx).getroot().iter("Param")}
+
+
+def independent_classes(mlp, ts=0.9, td=0.5, min_diffuse=1, min_specular=1):
     """Classes from the synthetic ground truth alone: a photo gives a vertex a diffuse sample when
     the vertex is visible from the photo's view, lit (no shadow), N.L >= T_d and R.E <= T_s; a
-    specular sample when visible, lit and R.E > T_s (pixels, saturation and mixed pixels ignored)."""
+    specular sample when visible, lit and R.E > T_s (pixels, saturation and mixed pixels ignored).
+    A vertex is diffusely (specularly) covered from min_diffuse (min_specular) samples."""
     base = os.path.dirname(os.path.abspath(mlp))
     gt = np.genfromtxt(os.path.join(base, "ground_truth", "gt_vertex.csv"), delimiter=",", names=True)
     normals = np.stack([gt["nx"], gt["ny"], gt["nz"]], 1)
@@ -192,7 +198,7 @@ def independent_classes(mlp, ts=0.9, td=0.5):
         diffuse += ok & (d >= td) & (s <= ts)
         specular += ok & (s > ts)
         seen_any |= seen
-    classes = np.where(~seen_any, 0, np.where(diffuse == 0, 1, np.where(specular == 0, 2, 3)))
+    classes = np.where(~seen_any, 0, np.where(diffuse < min_diffuse, 1, np.where(specular < min_specular, 2, 3)))
     return classes
 
 
@@ -234,7 +240,9 @@ def cmd_classes(a):
     colour_counts = [int((ours == c).sum()) for c in range(4)]
     if colour_counts != counts:
         failures.append(f"vertex colours {colour_counts} disagree with the suggestion file {counts}")
-    ref = independent_classes(a.project)
+    v = mlx_values(mlx)  # the thresholds the filter ran with
+    ref = independent_classes(a.project, float(v["specularThreshold"]), float(v["diffuseThreshold"]),
+                              int(v["minDiffuseSamples"]), int(v["minSpecularSamples"]))
     n = len(ref)
     agreement = float((ours == ref).mean()) if len(ours) == n else 0.0
     ref_counts = [int((ref == c).sum()) for c in range(4)]
@@ -291,7 +299,12 @@ def cmd_loop(a):
     before = lib.tree_checksums(src_dir)
     # What the whole candidate set gives (the target), from the command-line tool.
     full_sugg = os.path.join(work, "all_candidates.txt")
-    subprocess.run([a.coverage_tool, a.project, "--out", full_sugg], check=True, stdout=subprocess.DEVNULL)
+    # The same classification as the filters (the script's values; the import runs the defaults,
+    # which the script lists).
+    v = mlx_values(a.mlx)
+    subprocess.run([a.coverage_tool, a.project, "--out", full_sugg, "--ts", v["specularThreshold"],
+                    "--td", v["diffuseThreshold"], "--min-diffuse", v["minDiffuseSamples"],
+                    "--min-specular", v["minSpecularSamples"]], check=True, stdout=subprocess.DEVNULL)
     target = read_suggestions(full_sugg)
     target_full, target_diffuse = int(target["fully_covered"]), int(target["fully_covered"]) + int(target["diffuse_no_specular"])
     print(f"all {target['photos']} candidates: {target_diffuse} vertices diffusely covered, {target_full} fully")

@@ -3,6 +3,7 @@
 //   vbrdf_coverage project.mlp [--lp F] [--out suggestions.txt] [--fit result.ply]
 //                  [--viewpoint-raster N] [--visibility auto|gl|cpu] [--ts X] [--td X]
 //                  [--min-elevation DEG] [--poor-dq X] [--poor-sq X] [--classes out.ply]
+//                  [--min-diffuse N] [--min-specular N]
 // --fit: DQ/SQ of an earlier fit (its result PLY) make vertices with a poor fit count as needing.
 // --classes: writes the mesh coloured by class with float properties coverage_class, n_seen,
 // n_diffuse, n_specular (for checks and viewing).
@@ -25,7 +26,8 @@ namespace {
 int usage() {
   std::cerr << "usage: vbrdf_coverage project.mlp [--lp F] [--out F.txt] [--fit result.ply] [--viewpoint-raster N]\n"
                "                      [--visibility auto|gl|cpu] [--ts X] [--td X] [--min-elevation DEG]\n"
-               "                      [--poor-dq X] [--poor-sq X] [--classes out.ply]\n";
+               "                      [--poor-dq X] [--poor-sq X] [--classes out.ply] [--min-diffuse N]\n"
+               "                      [--min-specular N]\n";
   return 2;
 }
 
@@ -72,6 +74,8 @@ int main(int argc, char **argv) {
       else if (a == "--min-elevation") settings.suggest.min_elevation_deg = std::stof(next());
       else if (a == "--poor-dq") settings.poor_dq = std::stof(next());
       else if (a == "--poor-sq") settings.poor_sq = std::stof(next());
+      else if (a == "--min-diffuse") settings.min_diffuse = std::stoi(next());
+      else if (a == "--min-specular") settings.min_specular = std::stoi(next());
       else if (a == "--visibility") {
         const std::string v = next();
         settings.visibility_choice = v == "gl" ? VisibilityChoice::GL : v == "cpu" ? VisibilityChoice::CPU : VisibilityChoice::Auto;

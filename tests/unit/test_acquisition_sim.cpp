@@ -1,5 +1,6 @@
 // Table 4.1 simulation (acquisition_sim.h): constructed candidate sets with known answers, the
 // greedy choices, random order, stalling, and candidates gathered from a sample project.
+#include <algorithm>
 #include <cmath>
 #include <gtest/gtest.h>
 
@@ -169,6 +170,54 @@ TEST(AcquisitionSim, StallsWhenNoSuggestionCanReachTheRest) {
   EXPECT_EQ(simulate_acquisition(set, SimStrategy::Oracle, s).order, (std::vector<size_t>{0, 2}));
 }
 
+namespace {
+
+// Replays `run.order` on the candidate set from scratch and checks what the simulation reported:
+// the targets (vertices some candidate covers diffusely; of those, the ones some candidate covers
+// specularly), the uncovered targets after each photo, when diffuse and full coverage were
+// reached, and what was left. Also: the start photo first, no candidate taken twice.
+void expect_run_replays(const CandidateSet &set, const SimRun &run, size_t start) {
+  const size_t n = set.mesh.vertex_count;
+  ASSERT_FALSE(run.order.empty());
+  EXPECT_EQ(run.order.front(), start);
+  std::vector<bool> target_d(n, false), target_s(n, false);
+  for (size_t v = 0; v < n; ++v) {
+    bool any_s = false;
+    for (size_t c = 0; c < set.size(); ++c) {
+      target_d[v] = target_d[v] || set.covers_diffuse(c, v);
+      any_s = any_s || set.covers_specular(c, v);
+    }
+    target_s[v] = target_d[v] && any_s;
+  }
+  EXPECT_EQ(run.target_diffuse, size_t(std::count(target_d.begin(), target_d.end(), true)));
+  EXPECT_EQ(run.target_specular, size_t(std::count(target_s.begin(), target_s.end(), true)));
+  ASSERT_EQ(run.uncovered.size(), run.order.size());
+  std::vector<bool> has_d(n, false), has_s(n, false), taken(set.size(), false);
+  size_t reached_d = 0, reached_full = 0, left_d = 0, left_s = 0;
+  for (size_t k = 0; k < run.order.size(); ++k) {
+    const size_t c = run.order[k];
+    ASSERT_LT(c, set.size());
+    EXPECT_FALSE(taken[c]) << "candidate " << c << " taken twice";
+    taken[c] = true;
+    left_d = left_s = 0;
+    for (size_t v = 0; v < n; ++v) {
+      has_d[v] = has_d[v] || set.covers_diffuse(c, v);
+      has_s[v] = has_s[v] || set.covers_specular(c, v);
+      left_d += target_d[v] && !has_d[v];
+      left_s += target_s[v] && !has_s[v];
+    }
+    EXPECT_EQ(run.uncovered[k], left_d + left_s) << "after photo " << k + 1;
+    if (reached_d == 0 && left_d == 0) reached_d = k + 1;
+    if (reached_full == 0 && left_d == 0 && left_s == 0) reached_full = k + 1;
+  }
+  EXPECT_EQ(run.photos_diffuse, reached_d);
+  EXPECT_EQ(run.photos_full, reached_full);
+  EXPECT_EQ(run.left_diffuse, left_d);
+  EXPECT_EQ(run.left_specular, left_s);
+}
+
+} // namespace
+
 TEST(AcquisitionSim, GatheredCandidatesMatchTheCoverageCounts) {
   const Project p = read_project(test::source_dir() + "/sample_projects/synth_basic/project.mlp");
   const MeshData mesh = load_mesh_ply(p.mesh_path);
@@ -199,6 +248,21 @@ TEST(AcquisitionSim, GatheredCandidatesMatchTheCoverageCounts) {
               oracle.photos_full);
   EXPECT_GT(oracle.photos_full, 0u);
   EXPECT_LE(oracle.photos_full, 16u);
+  expect_run_replays(set, binned, s.start);
+  expect_run_replays(set, oracle, s.start);
+  // The binned suggestions reach full coverage within the 16 candidates, never more photos than
+  // candidates, and diffuse coverage no later than full coverage.
+  EXPECT_FALSE(binned.stalled);
+  EXPECT_GT(binned.photos_full, 0u);
+  EXPECT_LE(binned.photos_full, set.size());
+  EXPECT_EQ(binned.left_diffuse + binned.left_specular, 0u);
+  EXPECT_GT(binned.photos_diffuse, 0u);
+  EXPECT_LE(binned.photos_diffuse, binned.photos_full);
+  // Every decision after the start photo is a suggestion with its prediction and offset.
+  EXPECT_EQ(binned.predicted.size(), binned.order.size() - 1);
+  EXPECT_EQ(binned.gained.size(), binned.order.size() - 1);
+  EXPECT_EQ(binned.offset_deg.size(), binned.order.size() - 1);
+  for (float off : binned.offset_deg) EXPECT_TRUE(off >= 0.0f && off <= 180.0f) << off;
   // Candidates of two viewpoints are refused with the culprit named.
   const Project two = read_project(test::source_dir() + "/sample_projects/synth_two_views/project.mlp");
   const MeshData mesh2 = load_mesh_ply(two.mesh_path);

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -245,9 +244,6 @@ std::vector<uint8_t> run_light(VisibilityBackend &b, const MeshData &m, V3 dir) 
   return out;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // ---------------------------------------------------------------------------------------------
 // Scenes.
@@ -1054,48 +1050,31 @@ TEST_F(GlVisibilityTest, RejectsRenderTargetsLargerThanTheContextAllows) {
   EXPECT_GT(std::count(r.begin(), r.end(), 0), 100);
 }
 
-// Timings on ~100k vertices: camera pass at 1024x768 and light pass at 2048^2 (the second call of
-// each, once the render targets exist), and the CPU reference for comparison.
-TEST_F(GlVisibilityTest, PassesOn100kVerticesAreFast) {
+// ~100k vertices: the camera pass at 1024x768 and the light pass at 2048^2 agree with the CPU
+// reference on the front-facing vertices (second call of each: the render targets exist). Their
+// time is a benchmark figure, not a test on a shared machine: bench_gather --passes.
+TEST_F(GlVisibilityTest, PassesOn100kVerticesAgreeWithTheCpu) {
   const MeshData m = dense_scene(310, 32);
   const Shot shot = dense_scene_camera(1024, 768);
   const V3 light = normalized(kLights[1]);
-  auto t0 = std::chrono::steady_clock::now();
   auto g = gl(m);
-  const double upload = seconds_since(t0);
   run_camera(*g, m, shot);
   run_light(*g, m, light);
-  t0 = std::chrono::steady_clock::now();
   const auto cam = run_camera(*g, m, shot);
-  const double camera_s = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
   const auto lit = run_light(*g, m, light);
-  const double light_s = seconds_since(t0);
-
-  t0 = std::chrono::steady_clock::now();
   auto cpu = make_cpu_visibility(m.view(), VisibilitySettings());
-  const double grid_s = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
   const auto cam_cpu = run_camera(*cpu, m, shot);
-  const double cpu_camera_s = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
   const auto lit_cpu = run_light(*cpu, m, light);
-  const double cpu_light_s = seconds_since(t0);
 
   std::printf("  %u vertices, %zu triangles\n", vertex_count(m), m.indices.size() / 3);
-  std::printf("  GL:  upload %.3f s, camera pass 1024x768 %.3f s, light pass 2048^2 %.3f s\n", upload, camera_s,
-              light_s);
-  std::printf("  CPU: grid %.3f s, camera pass %.3f s, light pass %.3f s\n", grid_s, cpu_camera_s, cpu_light_s);
   const V3 c = centre_of(shot);
   const Comparison cam_cmp = compare(m, cam, cam_cpu, {}, nullptr, [&](size_t v) { return c - v3(&m.positions[3 * v]); });
   const Comparison lit_cmp = compare(m, lit, lit_cpu, {}, nullptr, [&](size_t) { return light; });
   std::printf("  disagreements: camera %zu (%zu front-facing), light %zu (%zu front-facing)\n", cam_cmp.total,
               cam_cmp.front_total, lit_cmp.total, lit_cmp.front_total);
+  EXPECT_GE(vertex_count(m), 95000u);  // the size the benchmark figure refers to
   EXPECT_LE(cam_cmp.front_fraction(), 0.02);
   EXPECT_LE(lit_cmp.front_fraction(), 0.02);
-  // Generous bounds (shared 2-core machines); the target is well under 0.2 s each.
-  EXPECT_LT(camera_s, 1.0);
-  EXPECT_LT(light_s, 1.0);
 }
 
 } // namespace

@@ -1,0 +1,131 @@
+#pragma once
+// The filter parameters that two or more Vertex BRDF filters share: each one is declared (name,
+// label, tooltip, default) and read back with its range check once, here, and every filter adds
+// and reads it through these functions, so a default, a range or a tooltip cannot drift between
+// filters. Parameters of one filter only stay in that filter's file. utf8() and canonical_path()
+// are in meshlab_bridge.h.
+//
+// Names are what .mlx scripts refer to: never rename one. Readers throw vbrdf::InputError
+// ("Parameter '<name>' ...") for a value out of range; they never return NaN.
+//
+// Where the filters used to disagree, the one rule is (README, "Filter parameters"):
+// - minSpecularSamples: 2 (the fit's) in coverage too, so that "fully covered" means what the fit
+//   needs for a Phong fit rather than a diffuse-only one.
+// - shadowMapSize: 0 = automatic (from the mesh's edge lengths) in every filter, coverage included.
+// - viewpointRaster -1: MeshLab's current raster (the last one loaded or imported, unless another
+//   was selected), in coverage as in the sphere filter.
+// Two defaults differ on purpose and say why: diffuseThreshold (fit 0.2, coverage 0.5: coverage
+// asks the photographer for well-lit samples) and outputLightFile (the sphere filter writes
+// <project>_sphere.lp, sphere lights only; the import writes <project>_lights.lp, the existing .lp
+// merged with the new lights).
+#include <string>
+#include <vector>
+
+#include <common/interfaces.h>
+
+#include "core/color_chart.h"
+#include "core/photo.h"
+#include "core/pipeline.h"
+#include "core/samples.h"
+#include "core/sphere_lights.h"
+#include "core/visibility.h"
+
+namespace vbrdf_plugin {
+
+// Throws vbrdf::InputError("Parameter '<param>' <what>") unless `ok`.
+void require(bool ok, const char *param, const std::string &what);
+
+// "x1 y1 ... x4 y4" (spaces, commas or semicolons between numbers), 8 per viewpoint; "" = none.
+// Throws InputError naming `param` for a word that is no finite number or a count not a multiple
+// of 8.
+std::vector<float> parse_corners(const QString &text, const char *param);
+
+namespace shared {
+
+extern const char *const kLightFile;              // "lightFile"
+extern const char *const kSpecularThreshold;      // "specularThreshold"
+extern const char *const kDiffuseThreshold;       // "diffuseThreshold"
+extern const char *const kPhotoEncoding;          // "photoEncoding"
+extern const char *const kSaturationLevel;        // "saturationLevel"
+extern const char *const kVisibilityBackend;      // "visibilityBackend"
+extern const char *const kDepthTolerance;         // "depthTolerance"
+extern const char *const kShadowMapSize;          // "shadowMapSize"
+extern const char *const kMemoryBudgetMB;         // "memoryBudgetMB"
+extern const char *const kMinSpecularSamples;     // "minSpecularSamples"
+extern const char *const kViewpointRaster;        // "viewpointRaster"
+extern const char *const kSphereCenterX;          // "sphereCenterX"
+extern const char *const kSphereCenterY;          // "sphereCenterY"
+extern const char *const kSphereRadius;           // "sphereRadius"
+extern const char *const kOutputLightFile;        // "outputLightFile"
+extern const char *const kColorCorrection;        // "colorCorrection"
+extern const char *const kChartCorners;           // "chartCorners"
+extern const char *const kExposureNormalisation;  // "exposureNormalisation"
+
+// Defaults that a reader of the code (or a test) may need by name.
+constexpr int kDefaultMinSpecularSamples = 2;  // = vbrdf::PhongFitOptions().min_specular_samples
+constexpr int kDefaultShadowMapSize = 0;       // automatic (vbrdf::resolved_shadow_map_size)
+constexpr float kCoverageDiffuseThreshold = 0.5f;  // the thesis's T_d (vbrdf::GatherSettings' default)
+
+// --- Light file (.lp) ---------------------------------------------------------------------------
+// "" = the default light-file rule (vbrdf::find_default_light_file). Returned as given: the
+// filter resolves it against the project folder.
+void add_light_file(RichParameterList &params);
+std::string light_file(const RichParameterList &params);
+
+// --- Sample classification and photos (fit, coverage) -------------------------------------------
+void add_specular_threshold(RichParameterList &params);
+enum class DiffuseThresholdUse { Fit, Coverage };  // picks the default and the tooltip's last words
+void add_diffuse_threshold(RichParameterList &params, DiffuseThresholdUse use);
+// photoEncoding also in relight and the sphere filter.
+void add_photo_encoding(RichParameterList &params);
+vbrdf::PhotoEncoding photo_encoding(const RichParameterList &params);
+// photoEncoding, saturationLevel, visibilityBackend, depthTolerance, shadowMapSize, memoryBudgetMB,
+// in this order (the fit's and the coverage's dialogs end with them).
+void add_photo_and_visibility(RichParameterList &params);
+// specularThreshold, diffuseThreshold, photoEncoding, saturationLevel and memoryBudgetMB into
+// `gather` (its other fields are kept).
+void read_gather(const RichParameterList &params, vbrdf::GatherSettings &gather);
+// visibilityBackend, depthTolerance and shadowMapSize.
+void read_visibility(const RichParameterList &params, vbrdf::VisibilityChoice &choice,
+                     vbrdf::VisibilitySettings &visibility);
+
+// shadowMapSize alone (relight): 0 = automatic, else [64, 16384].
+void add_shadow_map_size(RichParameterList &params);
+int shadow_map_size(const RichParameterList &params);
+
+// --- Coverage and fit ---------------------------------------------------------------------------
+void add_min_specular_samples(RichParameterList &params);
+int min_specular_samples(const RichParameterList &params);  // in [1, 1000]
+
+// --- Viewpoint (coverage, sphere) ---------------------------------------------------------------
+// -1 = MeshLab's current raster (else the last one), or a raster index from 0.
+void add_viewpoint_raster(RichParameterList &params);
+int viewpoint_raster(const RichParameterList &params);  // >= -1 (the upper bound needs the document)
+// The raster index `param` (from viewpoint_raster) names in `document`: -1 = the current raster,
+// else the last one. Throws InputError when the document has no raster or `param` is too large.
+size_t chosen_raster(MeshDocument &document, int param);
+
+// --- Mirror sphere (sphere, import) -------------------------------------------------------------
+// sphereCenterX, sphereCenterY, sphereRadius (pixels): radius 0 = find the sphere automatically.
+void add_sphere_outline(RichParameterList &params);
+// The given outline; r == 0 when the sphere is to be found. Throws InputError for a negative or
+// non-finite value.
+vbrdf::SphereCircle sphere_outline(const RichParameterList &params);
+// The same check for another outline's three parameters (the sphere filter's second sphere).
+vbrdf::SphereCircle sphere_outline(const RichParameterList &params, const char *x, const char *y, const char *r);
+
+enum class OutputLightFileUse { Sphere, Import };  // default name: <project>_sphere.lp, _lights.lp
+void add_output_light_file(RichParameterList &params, OutputLightFileUse use);
+std::string output_light_file(const RichParameterList &params);  // as given ("" = the default)
+// The default output .lp beside `project` (or in the working folder for an unsaved project).
+std::string default_output_light_file(const std::string &project, OutputLightFileUse use);
+
+// --- Colour correction (fit, relight) -----------------------------------------------------------
+// colorCorrection, chartCorners, exposureNormalisation, in this order.
+void add_color_correction(RichParameterList &params);
+vbrdf::ColorCorrectionChoice color_correction(const RichParameterList &params);
+std::vector<float> chart_corners(const RichParameterList &params);  // parse_corners
+vbrdf::ExposureMode exposure_normalisation(const RichParameterList &params);
+
+} // namespace shared
+} // namespace vbrdf_plugin
