@@ -35,7 +35,7 @@ std::vector<int> parse_list(const std::string &s) {
   return out;
 }
 // One camera and one light pass, timed on their second call (see the header).
-void time_passes(const std::string &backend, const MeshData &mesh, const Raster &raster, const float light[3],
+void time_passes(const std::string &backend, const MeshData &mesh, const Raster &raster, const LightSource &light,
                  test::OsMesaContext &context) {
   const VisibilitySettings settings;  // automatic shadow-map size, as the fit
   const double t0 = now();
@@ -82,7 +82,7 @@ int main(int argc, char **argv) {
   if (passes) {
     if (header) std::printf("passes,backend,vertices,width,height,shadow_map,setup_s,camera_pass_s,light_pass_s\n");
     for (const std::string b : {std::string("gl"), std::string("cpu")})
-      if (backend == "both" || backend == b) time_passes(b, mesh, project.rasters.at(0), all_lights.at(0).data(), context);
+      if (backend == "both" || backend == b) time_passes(b, mesh, project.rasters.at(0), all_lights.at(0), context);
     return 0;
   }
   if (header) std::printf("backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples\n");
