@@ -73,6 +73,7 @@ int CoverageFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | Me
 
 void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
   shared::add_light_file(params);
+  shared::add_light_placement(params);
   params.addParam(RichSaveFile(
       kSuggestionFile, "", "Text (*.txt)", "Suggestion file",
       "Where the suggestions are written (key: value lines, then the report); the vertices only a new "
@@ -107,6 +108,7 @@ void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &par
 vbrdf::CoverageSettings CoverageFilter::settings_from(const RichParameterList &params) {
   vbrdf::CoverageSettings s;
   s.light_file = shared::light_file(params);
+  shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
   s.suggestion_file = utf8(params.getSaveFileName(kSuggestionFile));
   s.viewpoint_raster = shared::viewpoint_raster(params);
   shared::read_gather(params, s.gather);

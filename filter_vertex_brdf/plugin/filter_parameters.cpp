@@ -34,6 +34,8 @@ std::vector<float> parse_corners(const QString &text, const char *param) {
 namespace shared {
 
 const char *const kLightFile = "lightFile";
+const char *const kDomeRadius = "domeRadius";
+const char *const kLightUnitScale = "lightUnitScale";
 const char *const kSpecularThreshold = "specularThreshold";
 const char *const kDiffuseThreshold = "diffuseThreshold";
 const char *const kPhotoEncoding = "photoEncoding";
@@ -67,11 +69,33 @@ int enum_value(const RichParameterList &params, const char *name, int count, con
 
 void add_light_file(RichParameterList &params) {
   params.addParam(RichOpenFile(
-      kLightFile, "", QStringList("Light positions (*.lp)"), "Light file (.lp)",
-      "RTI light file: first line the number of photos, then one line per photo: image file name and the "
-      "unit direction towards the light (x right, y up, z towards the camera). Photos are matched by file "
-      "name; entries for other photos are ignored. Empty: the most recently modified *.lp beside the project "
-      "or the photos that has an entry for every raster (the rule of every Vertex BRDF filter)."));
+      kLightFile, "", QStringList("Light files (*.lp *.json *.dome)"), "Light file (.lp, .json, .dome)",
+      "Each photo's light. RTI .lp: first line the number of photos, then one line per photo: image file name "
+      "and the unit direction towards the light (x right, y up, z towards the camera): distant lights, or "
+      "lights on a dome with 'Dome radius'. Near lights (a dome, a flash or a lamp within a few object sizes): "
+      ".json with \"images\" and \"position_world\" (mesh frame and units) or \"position_camera\" (each "
+      "photo's camera frame), or a Relight .dome (cm: set 'Light unit scale'). Photos are matched by file "
+      "name. Empty: the most recently modified *.lp beside the project or the photos that has an entry for "
+      "every raster (the rule of every Vertex BRDF filter)."));
+}
+
+void add_light_placement(RichParameterList &params) {
+  params.addParam(RichFloat(kDomeRadius, 0.0f, "Dome radius (mesh units)",
+                            "0: the .lp's directions are distant lights (one direction for the whole object). "
+                            "> 0: they are point lights on a dome of this radius around the mesh's centre, so "
+                            "that each vertex gets its own light direction and a 1/distance^2 fall-off. Use it "
+                            "when the lights are within about 10 object sizes (README, \"Near lights\")."));
+  params.addParam(RichFloat(kLightUnitScale, 0.0f, "Light unit scale",
+                            "Mesh units per unit of the light file's positions: 0 = the .json's positions are in "
+                            "mesh units; a Relight .dome is in cm and needs it (10 for a mesh in mm, 0.01 for "
+                            "metres)."));
+}
+
+void read_light_placement(const RichParameterList &params, float &dome_radius, float &unit_scale) {
+  dome_radius = params.getFloat(kDomeRadius);
+  unit_scale = params.getFloat(kLightUnitScale);
+  require(std::isfinite(dome_radius) && dome_radius >= 0, kDomeRadius, "must be 0 (distant lights) or positive");
+  require(std::isfinite(unit_scale) && unit_scale >= 0, kLightUnitScale, "must be 0 (not given) or positive");
 }
 
 std::string light_file(const RichParameterList &params) { return utf8(params.getOpenFileName(kLightFile)); }

@@ -43,6 +43,8 @@ std::vector<float> parse_corners(const QString &text, const char *param);
 namespace shared {
 
 extern const char *const kLightFile;              // "lightFile"
+extern const char *const kDomeRadius;             // "domeRadius"
+extern const char *const kLightUnitScale;         // "lightUnitScale"
 extern const char *const kSpecularThreshold;      // "specularThreshold"
 extern const char *const kDiffuseThreshold;       // "diffuseThreshold"
 extern const char *const kPhotoEncoding;          // "photoEncoding"
@@ -71,6 +73,10 @@ constexpr float kCoverageDiffuseThreshold = 0.5f;  // the thesis's T_d (vbrdf::G
 // filter resolves it against the project folder.
 void add_light_file(RichParameterList &params);
 std::string light_file(const RichParameterList &params);
+// domeRadius and lightUnitScale (fit, coverage, relight: wherever lightFile is read with its
+// positions), right after lightFile. Both >= 0 (0 = not given); InputError otherwise.
+void add_light_placement(RichParameterList &params);
+void read_light_placement(const RichParameterList &params, float &dome_radius, float &unit_scale);
 
 // --- Sample classification and photos (fit, coverage) -------------------------------------------
 void add_specular_threshold(RichParameterList &params);

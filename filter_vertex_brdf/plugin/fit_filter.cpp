@@ -79,6 +79,7 @@ int FitFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | MeshMod
 
 void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
   shared::add_light_file(params);
+  shared::add_light_placement(params);
   params.addParam(RichSaveFile(
       kOutputPly, "", "PLY (*.ply)", "Output PLY",
       "Where the mesh with the per-vertex results is written (binary PLY with float properties), with a "
@@ -120,6 +121,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
 vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   vbrdf::FitSettings s;
   s.light_file = shared::light_file(params);
+  shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
   s.output_ply = utf8(params.getSaveFileName(kOutputPly));
   shared::read_gather(params, s.gather);
   shared::read_visibility(params, s.visibility_choice, s.visibility);

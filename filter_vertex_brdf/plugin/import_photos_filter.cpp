@@ -87,6 +87,11 @@ std::string lights_from_sphere(const Settings &s, const std::vector<vbrdf::Raste
                                const std::string &project, const std::function<void(const std::string &)> &log) {
   const vbrdf::Raster &reference = rasters[reference_index];
   const std::string given = resolve_path(s.light_file, project);
+  const std::string ext = given.size() >= 3 ? given.substr(given.size() - 3) : "";
+  if (!given.empty() && ext != ".lp" && ext != ".LP")
+    throw vbrdf::InputError("Parameter '" + std::string(shared::kLightFile) + "': the import merges the new photos' "
+                            "lights into an RTI .lp, but '" + given + "' is not one (light positions in .json or "
+                            ".dome are not merged). Give the .lp of the earlier photos, or leave it empty.");
   const std::string existing_lp = given.empty() ? vbrdf::find_default_light_file(rasters, project) : given;
   std::vector<vbrdf::LightEntry> existing;
   if (!existing_lp.empty()) existing = vbrdf::read_light_file(existing_lp);

@@ -47,6 +47,7 @@ RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &pa
   s.fit_result_ply = utf8(params.getOpenFileName(kFitResultPly));
   s.raster_project = utf8(params.getOpenFileName(kRasterProject));
   s.light_file = shared::light_file(params);
+  shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
   s.output_folder = utf8(params.getString(kOutputFolder));
   s.render_rasters = params.getBool(kRenderRasters);
   s.novel_view = params.getBool(kNovelView);
@@ -233,6 +234,7 @@ void RelightFilter::initParameters(const MeshDocument &, RichParameterList &para
                                "photos (heldout/project.mlp) to measure relighting on lights the fit never saw. "
                                "Its mesh is ignored; its cameras must be registered to the current mesh."));
   shared::add_light_file(params);
+  shared::add_light_placement(params);
   params.addParam(RichString(kOutputFolder, "", "Output folder",
                              "Where the images, contact_sheet.png and relight_table.csv are written (created if "
                              "needed; existing files of the same names are replaced). Relative paths are relative "
@@ -286,7 +288,7 @@ void RelightFilter::apply(FilterRun &run) const {
                               "of the rendered rasters.");
     const vbrdf::MeshView view = arrays.data.view();
     lights = vbrdf::resolve_lights(set.rasters, set.light_file,
-                                   vbrdf::light_placement_of(view.positions, view.vertex_count, 0.0f, 0.0f));
+                                   vbrdf::light_placement_of(view.positions, view.vertex_count, s.dome_radius, s.light_unit_scale));
   }
 
   GlContextScope gl(run.gl_context, log);

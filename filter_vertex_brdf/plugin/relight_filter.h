@@ -22,6 +22,7 @@ public:
 
   struct Settings {
     std::string fit_result_ply, raster_project, light_file, output_folder;  // as given ("" = default)
+    float dome_radius = 0, light_unit_scale = 0;  // light_source.h LightPlacement
     bool render_rasters = true, novel_view = false;
     int view_raster = 0;
     float azimuth = 0, elevation = 0, distance_scale = 1;  // orbit of the novel view (degrees, factor)

@@ -12,6 +12,7 @@ fit.mlx with outputPly set), outputs, logs and, for bad-input cases, a broken co
 Source and shared folders are only read; their checksums are compared before and after.
 """
 import argparse
+import json
 import os
 import re
 import shutil
@@ -128,6 +129,17 @@ def cmd_fit(a):
         cmd = [a.eval_tool, "--result", out_ply, "--project", a.heldout]
         if a.heldout_photo_dir:
             cmd += ["--photo-dir", a.heldout_photo_dir]
+        if a.heldout_lp:
+            cmd += ["--lp", a.heldout_lp]
+        if a.gt_lit_npz:  # the ground truth's lit flags per held-out light (the protocol of issue 9)
+            lit = np.load(a.gt_lit_npz)["heldout_lit"].astype(bool)
+            lit_txt = os.path.join(work, "gt_lit.txt")
+            with open(lit_txt, "w") as f:
+                f.write(f"{lit.shape[0]} {lit.shape[1]}\n")
+                for row in lit:
+                    f.write("".join("1" if b else "0" for b in row) + "\n")
+            cmd += ["--gt-lit", lit_txt]
+        cmd += a.eval_arg or []
         # Bounds on vbrdf_eval's headline figure, the whole visible surface (silhouettes, contacts,
         # every vertex; issue 9), and on its labelled "clean pixels, modelled vertices only" figure.
         if a.max_ws_mean is not None:
@@ -246,6 +258,15 @@ def break_project(case, proj_dir, mlp, lp):
             return v, f
         edit_mesh(mesh, zero_all)
         return ["no per-vertex normals", "Re-Compute Vertex Normals"]
+    if case == "light_inside":  # a light-position file whose first light sits inside the object
+        ply = lib.read_ply(mesh)
+        centre = [float((ply.vertex[c].min() + ply.vertex[c].max()) / 2) for c in "xyz"]
+        far = [c + 100.0 for c in centre]
+        images = [os.path.basename(photo) for _, photo in labels]
+        positions = [centre] + [far] * (len(images) - 1)
+        lib.write_text(os.path.join(proj_dir, "lights_near.json"),
+                       json.dumps({"images": images, "position_world": positions}))
+        return ["lights_near.json", images[0], "inside the mesh's bounding box"]
     if case == "empty_mesh":
         edit_mesh(mesh, lambda v, f: (v[:0], np.zeros((0, 3), np.int64)))
         return ["has no vertices"]
@@ -266,7 +287,10 @@ def cmd_bad(a):
 
     out_dir = fresh_dir(os.path.join(work, "out"))
     mlx = os.path.join(work, "fit.mlx")
-    lib.write_mlx(a.mlx, mlx, {"outputPly": os.path.join(out_dir, "result.ply")})
+    values = {"outputPly": os.path.join(out_dir, "result.ply")}
+    if a.case == "light_inside":
+        values["lightFile"] = os.path.join(proj_dir, "lights_near.json")
+    lib.write_mlx(a.mlx, mlx, values)
     before = lib.tree_checksums(proj_dir)
     rc, log = run_meshlabserver(a.wrapper, mlp, mlx, os.path.join(work, "meshlabserver.log"))
     print("\n".join(l for l in log.splitlines() if "failed" in l or "Problem" in l or "Failed" in l))
@@ -342,6 +366,9 @@ def main(argv=None):
     fit.add_argument("--heldout", help="held-out project.mlp: score the relit error with --eval-tool")
     fit.add_argument("--heldout-photo-dir", help="photos for the held-out project (same file names)")
     fit.add_argument("--eval-tool", help="the vbrdf_eval binary")
+    fit.add_argument("--heldout-lp", help="light file of the held-out photos (.lp, .json, .dome)")
+    fit.add_argument("--eval-arg", action="append", help="one more vbrdf_eval argument (repeatable)")
+    fit.add_argument("--gt-lit-npz", help="gt_vertex.npz whose heldout_lit decides which held-out samples are lit")
     fit.add_argument("--max-relit-mean", type=float)
     fit.add_argument("--max-relit-p95", type=float)
     fit.add_argument("--max-ws-mean", type=float, help="bound on the whole-surface relit CIEDE2000 mean")

@@ -78,6 +78,8 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
 TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   RichParameterList p = defaults_of(FitFilter());
   p.setValue("lightFile", FileValue("a.lp"));
+  p.setValue("domeRadius", FloatValue(2.5f));
+  p.setValue("lightUnitScale", FloatValue(10.0f));
   p.setValue("outputPly", FileValue("out.ply"));
   p.setValue("specularThreshold", FloatValue(0.8f));
   p.setValue("diffuseThreshold", FloatValue(0.3f));
@@ -99,6 +101,8 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("exposureNormalisation", EnumValue(2));
   const vbrdf::FitSettings s = FitFilter::settings_from(p);
   EXPECT_EQ(s.light_file, "a.lp");
+  EXPECT_FLOAT_EQ(s.dome_radius, 2.5f);
+  EXPECT_FLOAT_EQ(s.light_unit_scale, 10.0f);
   EXPECT_EQ(s.output_ply, "out.ply");
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, 0.8f);
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, 0.3f);
@@ -135,6 +139,8 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
   rejects("memoryBudgetMB", IntValue(8));
   rejects("initialShininess", FloatValue(0.5f));
   rejects("maxIterations", IntValue(-1));
+  rejects("domeRadius", FloatValue(-1.0f));
+  rejects("lightUnitScale", FloatValue(std::nanf("")));
   rejects("minSpecularSamples", IntValue(0));
   rejects("fillUnseenRings", IntValue(-2));
   rejects("chartCorners", StringValue("1 2 3"));
@@ -411,7 +417,8 @@ TEST(SharedParameters, EveryFilterDeclaresASharedNameIdentically) {
       shared::kDepthTolerance,    shared::kShadowMapSize,     shared::kMemoryBudgetMB,
       shared::kMinSpecularSamples, shared::kViewpointRaster,  shared::kSphereCenterX,
       shared::kSphereCenterY,     shared::kSphereRadius,      shared::kOutputLightFile,
-      shared::kColorCorrection,   shared::kChartCorners,      shared::kExposureNormalisation};
+      shared::kColorCorrection,   shared::kChartCorners,      shared::kExposureNormalisation,
+      shared::kDomeRadius,        shared::kLightUnitScale};
   // Their default (and the tooltip's last words) differ on purpose: filter_parameters.h says why.
   const std::set<std::string> deliberate = {shared::kDiffuseThreshold, shared::kOutputLightFile};
   for (const auto &kv : seen) {
