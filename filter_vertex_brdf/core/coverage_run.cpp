@@ -41,12 +41,6 @@ std::string vec3(const float v[3], int digits = 4) {
   return fixed(v[0], digits) + " " + fixed(v[1], digits) + " " + fixed(v[2], digits);
 }
 
-std::string strip_extension(const std::string &path) {
-  const size_t dot = path.find_last_of('.');
-  const size_t slash = path.find_last_of('/');
-  return (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? path : path.substr(0, dot);
-}
-
 float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // A mesh normal, normalised (file normals need not be unit length).
@@ -732,8 +726,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   std::vector<std::string> unused;
   const LightPlacement placement =
       light_placement_of(mesh.positions, mesh.vertex_count, settings.dome_radius, settings.light_unit_scale);
-  const std::string ext = r.light_file.size() >= 3 ? r.light_file.substr(r.light_file.size() - 3) : "";
-  const bool plain_lp = placement.dome_radius <= 0 && (ext == ".lp" || ext == ".LP");
+  const bool plain_lp = placement.dome_radius <= 0 && extension_of(r.light_file) == "lp";
   const std::vector<LightSource> sources =
       plain_lp ? directional_lights(lights_for_rasters(input.rasters, r.light_file, &unused))
                : resolve_lights(input.rasters, r.light_file, placement);

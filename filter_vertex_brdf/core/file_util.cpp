@@ -32,4 +32,15 @@ std::string to_lower(std::string s) {
   return s;
 }
 
+std::string strip_extension(const std::string &path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of("/\\");
+  return (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? path : path.substr(0, dot);
+}
+
+std::string extension_of(const std::string &path) {
+  const std::string stem = strip_extension(path);
+  return stem.size() < path.size() ? to_lower(path.substr(stem.size() + 1)) : std::string();
+}
+
 } // namespace vbrdf

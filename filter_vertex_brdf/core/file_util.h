@@ -9,5 +9,7 @@ std::string directory_of(const std::string &path);       // "a/b/c.png" -> "a/b"
 std::string join_path(const std::string &dir, const std::string &name);  // absolute name wins
 bool file_exists(const std::string &path);
 std::string to_lower(std::string s);
+std::string strip_extension(const std::string &path);  // "a/b.c/d.png" -> "a/b.c/d"
+std::string extension_of(const std::string &path);     // "a/B.LP" -> "lp" (lower case; "" if none)
 
 } // namespace vbrdf

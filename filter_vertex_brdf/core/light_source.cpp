@@ -10,6 +10,7 @@
 #include "errors.h"
 #include "file_util.h"
 #include "light_file.h"
+#include "output_ply.h"  // write_text_file_atomically
 
 namespace vbrdf {
 
@@ -266,14 +267,6 @@ std::vector<LightSource> from_dome(const std::vector<Raster> &rasters, const std
   return lights;
 }
 
-std::string lower_extension(const std::string &path) {
-  const size_t dot = path.find_last_of('.');
-  const size_t slash = path.find_last_of('/');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string e = path.substr(dot + 1);
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return e;
-}
 } // namespace
 
 LightSource LightSource::directional(const std::array<float, 3> &towards_light) {
@@ -338,6 +331,43 @@ LightPlacement light_placement_of(const float *positions, size_t vertex_count, f
   return p;
 }
 
+namespace {
+std::string json_string(const std::string &s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+} // namespace
+
+void write_light_positions(const std::string &path, const std::vector<std::string> &images,
+                           const std::vector<std::array<float, 3>> &positions_world, const std::vector<float> &rms) {
+  if (images.size() != positions_world.size() || (!rms.empty() && rms.size() != images.size()))
+    throw InputError("Light positions for '" + path + "': " + std::to_string(images.size()) + " images, " +
+                     std::to_string(positions_world.size()) + " positions.");
+  std::ostringstream out;
+  out.precision(9);
+  out << "{\n \"format\": \"vertex-brdf light positions: world frame, mesh units\",\n \"images\": [";
+  for (size_t i = 0; i < images.size(); ++i) out << (i ? ", " : "") << json_string(images[i]);
+  out << "],\n \"position_world\": [";
+  for (size_t i = 0; i < positions_world.size(); ++i) {
+    for (float c : positions_world[i])
+      if (!std::isfinite(c)) throw InputError("Light positions for '" + path + "': '" + images[i] + "' is not finite.");
+    out << (i ? ", " : "") << "[" << positions_world[i][0] << ", " << positions_world[i][1] << ", "
+        << positions_world[i][2] << "]";
+  }
+  out << "]";
+  if (!rms.empty()) {
+    out << ",\n \"position_rms_world\": [";
+    for (size_t i = 0; i < rms.size(); ++i) out << (i ? ", " : "") << (std::isfinite(rms[i]) ? rms[i] : -1.0f);
+    out << "]";
+  }
+  out << "\n}\n";
+  write_text_file_atomically(path, out.str());
+}
+
 void check_light_positions(const std::vector<LightSource> &lights, const std::vector<Raster> &rasters,
                            const LightPlacement &placement, const std::string &path) {
   const float half_diagonal = 0.5f * box_diagonal(placement);
@@ -377,7 +407,7 @@ void set_reference_distance(std::vector<LightSource> &lights, const LightPlaceme
 
 std::vector<LightSource> resolve_lights(const std::vector<Raster> &rasters, const std::string &path,
                                         const LightPlacement &placement) {
-  const std::string ext = lower_extension(path);
+  const std::string ext = extension_of(path);
   std::vector<LightSource> lights;
   if (ext == "json")
     lights = from_json(rasters, path, placement);

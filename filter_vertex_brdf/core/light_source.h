@@ -81,6 +81,14 @@ LightPlacement light_placement_of(const float *positions, size_t vertex_count, f
 std::vector<LightSource> resolve_lights(const std::vector<Raster> &rasters, const std::string &path,
                                         const LightPlacement &placement);
 
+// Writes our .json form ("images" + "position_world", mesh frame and units) atomically; `rms`
+// (optional, one per image) is written as "position_rms_world", how far the rays that located each
+// light miss it (readers ignore it). Throws InputError for mismatched sizes or non-finite values,
+// ProcessingError on I/O.
+void write_light_positions(const std::string &path, const std::vector<std::string> &images,
+                           const std::vector<std::array<float, 3>> &positions_world,
+                           const std::vector<float> &rms = {});
+
 // Checks positional lights against the placement (the rule above); throws InputError naming
 // `path` and the photo of the first bad light. Directional lights always pass.
 void check_light_positions(const std::vector<LightSource> &lights, const std::vector<Raster> &rasters,

@@ -33,12 +33,6 @@ std::string percent(uint64_t part, uint64_t whole) {
   return whole ? fixed(100.0 * double(part) / double(whole), 1) + "%" : "0%";
 }
 
-std::string strip_extension(const std::string &path) {
-  const size_t dot = path.find_last_of('.');
-  const size_t slash = path.find_last_of('/');
-  return (dot == std::string::npos || (slash != std::string::npos && dot < slash)) ? path : path.substr(0, dot);
-}
-
 std::string report_path_for(const std::string &ply) { return strip_extension(ply) + "_report.txt"; }
 
 uint8_t srgb_byte(float linear) { return uint8_t(std::lround(255.0f * linear_to_srgb(linear))); }

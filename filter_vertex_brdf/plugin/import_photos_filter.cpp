@@ -87,8 +87,7 @@ std::string lights_from_sphere(const Settings &s, const std::vector<vbrdf::Raste
                                const std::string &project, const std::function<void(const std::string &)> &log) {
   const vbrdf::Raster &reference = rasters[reference_index];
   const std::string given = resolve_path(s.light_file, project);
-  const std::string ext = given.size() >= 3 ? given.substr(given.size() - 3) : "";
-  if (!given.empty() && ext != ".lp" && ext != ".LP")
+  if (!given.empty() && vbrdf::extension_of(given) != "lp")
     throw vbrdf::InputError("Parameter '" + std::string(shared::kLightFile) + "': the import merges the new photos' "
                             "lights into an RTI .lp, but '" + given + "' is not one (light positions in .json or "
                             ".dome are not merged). Give the .lp of the earlier photos, or leave it empty.");

@@ -14,6 +14,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/light_file.h"
+#include "core/light_source.h"
 #include "core/photo.h"
 #include "core/pipeline.h"
 #include "core/sphere_lights.h"
@@ -113,8 +114,17 @@ std::map<size_t, vbrdf::LightEntry> other_viewpoint_entries(const std::string &o
   return kept;
 }
 
-// Near-light positions: camera frame -> world (a MeshLab shot is rigid, so world units once the
-// sphere radius is known in world units).
+// A triangulated near-light position in the world frame (a MeshLab shot is rigid, so these are
+// world units once the sphere radius is known in world units: the core then scales them).
+std::array<float, 3> world_position(const vbrdf::PhotoLight &pl, const vbrdf::Raster &r) {
+  const float p[3] = {float(pl.position[0]), float(pl.position[1]), float(pl.position[2])};
+  const float length = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+  float dir[3], centre[3];
+  vbrdf::camera_to_world_direction(r.shot, p, dir);
+  vbrdf::camera_centre(r.shot, centre);
+  return {{centre[0] + length * dir[0], centre[1] + length * dir[1], centre[2] + length * dir[2]}};
+}
+
 void log_positions(const vbrdf::LightCalibration &cal, const std::vector<vbrdf::Raster> &rasters,
                    const std::vector<size_t> &group, double radius_world,
                    const std::function<void(const std::string &)> &log) {
@@ -130,14 +140,9 @@ void log_positions(const vbrdf::LightCalibration &cal, const std::vector<vbrdf::
               pl.position[0], pl.position[1], pl.position[2], pl.position_rms));
       continue;
     }
-    const float p[3] = {float(pl.position[0]), float(pl.position[1]), float(pl.position[2])};
-    const float length = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    float dir[3], centre[3];
-    vbrdf::camera_to_world_direction(r.shot, p, dir);
-    vbrdf::camera_centre(r.shot, centre);
+    const std::array<float, 3> w = world_position(pl, r);
     log(std::string(kPrefix) + name +
-        fmt(": near light at world (%.4f, %.4f, %.4f), RMS miss %.4f.", centre[0] + length * dir[0],
-            centre[1] + length * dir[1], centre[2] + length * dir[2], pl.position_rms));
+        fmt(": near light at world (%.4f, %.4f, %.4f), RMS miss %.4f.", w[0], w[1], w[2], pl.position_rms));
   }
 }
 
@@ -165,6 +170,47 @@ std::vector<vbrdf::LightEntry> lp_entries(const vbrdf::LightCalibration &cal, co
   std::vector<vbrdf::LightEntry> out_entries;
   for (const auto &kv : entries) out_entries.push_back(kv.second);
   return out_entries;
+}
+
+// With two spheres and their radius in world units: the triangulated positions of this viewpoint's
+// lights as a light-position file beside the .lp (<name>_positions.json, light_source.h), for
+// the fit's lightFile, when every photo of the viewpoint has one; the log says how precise they
+// are (the rays' RMS miss) or why no file was written.
+void write_positions(const vbrdf::LightCalibration &cal, const std::vector<vbrdf::Raster> &rasters,
+                     const std::vector<size_t> &group, double radius_world, const std::string &out_lp,
+                     const std::function<void(const std::string &)> &log) {
+  size_t with_position = 0;
+  for (const vbrdf::PhotoLight &pl : cal.photos) with_position += pl.valid && pl.has_position;
+  if (with_position == 0) return;  // distant lights (or one sphere): the .lp says it all
+  if (radius_world <= 0) {
+    log(std::string(kPrefix) + "near-light positions were triangulated for " + std::to_string(with_position) +
+        " photo(s); give 'sphereRadiusWorld' (the spheres' radius in mesh units) to get them in the mesh's frame "
+        "as a light-position file for the fit.");
+    return;
+  }
+  if (with_position < group.size()) {
+    log(std::string(kPrefix) + "no light-position file: " + std::to_string(group.size() - with_position) +
+        " photo(s) of the viewpoint have no triangulated position (no light, or spheres that agree within "
+        "a degree: a distant light). Fit with the .lp, or with 'domeRadius' if the lights stand on a dome.");
+    return;
+  }
+  const QDir folder = QFileInfo(QString::fromStdString(out_lp)).absoluteDir();
+  std::vector<std::string> images;
+  std::vector<std::array<float, 3>> positions;
+  std::vector<float> rms;
+  for (size_t i = 0; i < group.size(); ++i) {
+    images.push_back(lp_image_name(folder, rasters[group[i]].image_path));
+    positions.push_back(world_position(cal.photos[i], rasters[group[i]]));
+    rms.push_back(float(cal.photos[i].position_rms));
+  }
+  std::vector<float> sorted = rms;
+  std::sort(sorted.begin(), sorted.end());
+  const std::string path = vbrdf::strip_extension(out_lp) + "_positions.json";
+  vbrdf::write_light_positions(path, images, positions, rms);
+  log(std::string(kPrefix) + "wrote the " + std::to_string(group.size()) + " triangulated light positions to '" +
+      path + "'" + fmt(" (the reflected rays miss them by %.4g median, %.4g at most, in mesh units). ",
+                       sorted[sorted.size() / 2], sorted.back()) +
+      "For near lights, set the fit's lightFile to it.");
 }
 
 void validate_viewpoint(const std::vector<vbrdf::Raster> &rasters, const std::vector<size_t> &group) {
@@ -295,6 +341,7 @@ void SphereFilter::apply(FilterRun &run) const {
   log(std::string(kPrefix) + "wrote " + std::to_string(cal.valid_count()) + " light direction(s) to '" + out + "'" +
       (kept.empty() ? std::string() : " (kept " + std::to_string(kept.size()) + " entries of other viewpoints)") +
       ". To fit with them, set lightFile to '" + out + "' in \"" + kFitFilterName + "\".");
+  write_positions(cal, rasters, group, p.radius_world, out, log);
   if (cal.valid_count() < group.size())
     log(std::string(kPrefix) + "Warning: " + std::to_string(group.size() - cal.valid_count()) +
         " photo(s) got no light and have no entry in the .lp: the fit will ask for them; remove those rasters or "

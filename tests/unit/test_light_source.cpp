@@ -91,6 +91,18 @@ TEST(LightSource, JsonPositionsInTheWorldAndCameraFrames) {
   EXPECT_NE(describe_lights(cam, s.placement).find("2 point lights"), std::string::npos);
 }
 
+// What the sphere filter writes for triangulated near lights reads back as the same lights.
+TEST(LightSource, WrittenPositionsReadBack) {
+  const Capture s;
+  const std::string path = s.dir + "/written_positions.json";
+  write_light_positions(path, {"a.png", "b.png"}, {{{3, 0, 2.5f}}, {{-1, 4, 2}}}, {0.01f, 0.02f});
+  const std::vector<LightSource> lights = resolve_lights(s.rasters, path, s.placement);
+  EXPECT_LT(dist3(lights[0].position, {{3, 0, 2.5f}}), 1e-5f);
+  EXPECT_LT(dist3(lights[1].position, {{-1, 4, 2}}), 1e-5f);
+  EXPECT_THROW(write_light_positions(path, {"a.png"}, {{{0, 0, 1}}, {{0, 0, 2}}}), InputError);
+  EXPECT_THROW(write_light_positions(path, {"a.png"}, {{{0, 0, std::nanf("")}}}), InputError);
+}
+
 TEST(LightSource, RelightDomeFormsAndDomeRadius) {
   Capture s;
   // Relight's frame: origin on the optical axis at the depth of the box centre (the world origin
