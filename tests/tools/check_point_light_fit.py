@@ -43,7 +43,11 @@ import check_output  # noqa: E402
 SCENE_ARGS = ["--vertices", "5000", "--width", "480", "--height", "360", "--lights", "48", "--ss", "1",
               "--heldout", "0", "--light-elevation", "20", "85"]
 FIGURES = ("rho_median_rel", "ks_median_rel", "shininess_median_rel")
-RATIO = 1.25
+# Measured (this scene; D = 2 / 3 / 5), dir vs point: rho 0.0031 vs 0.0036 / 0.0035 / 0.0034;
+# k_s 0.024-0.027 vs 0.023 / 0.036 / 0.026 and alpha 0.018-0.021 vs 0.018 / 0.025 / 0.017 on the
+# 30 / 40 / 54 common vertices. Medians over a few dozen vertices move by ~0.01 with the set, hence
+# the absolute slack beside the ratio. Light positions 25 % too far (a broken fall-off of that
+# size) give rho 0.018 and k_s 0.28: both fail. .lp only (D = 2 / 3 / 5): rho 0.12 / 0.083 / 0.054.
 SLACK = {"rho_median_rel": 0.005, "ks_median_rel": 0.02, "shininess_median_rel": 0.02}
 MIN_COMMON = 20
 MIN_DETERMINED = 0.8
