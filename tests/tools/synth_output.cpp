@@ -102,16 +102,29 @@ void write_lp(const std::string &path, const std::vector<Photo> &photos) {
 }
 
 void write_lights_json(const std::string &path, const std::vector<Photo> &photos,
-                       float irradiance) {
+                       float irradiance, const PointLightSetup *point) {
   std::ostringstream o;
   auto list = [&](const char *key, const std::function<std::string(const Photo &)> &f, bool last) {
     o << " \"" << key << "\": [";
     for (size_t i = 0; i < photos.size(); ++i) o << (i ? ",\n  " : "\n  ") << f(photos[i]);
     o << "\n ]" << (last ? "\n" : ",\n");
   };
-  o << "{\n \"type\": \"directional\",\n \"frame_note\": \"dir_world = unit vector from the "
-       "object towards the light (world frame, +y up); dir_cam = same in the camera frame of "
+  o << "{\n \"type\": \"" << (point ? "point" : "directional")
+    << "\",\n \"frame_note\": \"dir_world = unit vector from the "
+    << (point ? "bounding-box centre" : "object")
+    << " towards the light (world frame, +y up); dir_cam = same in the camera frame of "
        "the photo's view (x right, y up, z towards viewer), as written in lights.lp\",\n";
+  if (point) {
+    o << " \"note\": \"isotropic point lights at position_world = centre + distance * dir_world; "
+         "irradiance at x = irradiance * (distance / |position_world - x|)^2, so 'irradiance' is "
+         "the irradiance at the centre; radiant_intensity = irradiance * distance^2\",\n"
+      << " \"centre\": " << json_vec(point->centre) << ",\n"
+      << " \"half_diagonal\": " << fmt("%.9g", point->half_diagonal) << ",\n"
+      << " \"distance\": " << fmt("%.9g", point->distance) << ",\n"
+      << " \"radiant_intensity\": "
+      << fmt("%.9g", double(irradiance) * point->distance * point->distance) << ",\n";
+    list("position_world", [](const Photo &p) { return json_vec(p.pos_world); }, false);
+  }
   o << " \"irradiance\": " << fmt("%.9g", irradiance) << ",\n";
   list("images", [](const Photo &p) { return "\"" + p.file + "\""; }, false);
   list("view", [](const Photo &p) { return std::to_string(p.view); }, false);
@@ -124,6 +137,16 @@ void write_lights_json(const std::string &path, const std::vector<Photo> &photos
     return fmt("%.6f", std::atan2(p.dir_cam.y, p.dir_cam.x) * 180 / kPi);
   }, true);
   o << "}\n";
+  write_text(path, o.str());
+}
+
+void write_positions_json(const std::string &path, const std::vector<Photo> &photos) {
+  std::ostringstream o;
+  o << "{\n \"images\": [";
+  for (size_t i = 0; i < photos.size(); ++i) o << (i ? ",\n  " : "\n  ") << "\"" << photos[i].file << "\"";
+  o << "\n ],\n \"position_world\": [";
+  for (size_t i = 0; i < photos.size(); ++i) o << (i ? ",\n  " : "\n  ") << json_vec(photos[i].pos_world);
+  o << "\n ]\n}\n";
   write_text(path, o.str());
 }
 

@@ -15,6 +15,15 @@ struct Photo {
   std::string dir_text;  // light direction in the camera frame as written in the .lp
   V3 dir_cam;            // the same, parsed back from dir_text and normalised
   V3 dir_world;          // world frame (through the shot's rotation)
+  bool point = false;    // --light-distance: an isotropic point light at pos_world
+  V3 pos_world;          // centre + distance * dir_world (world frame, mesh units)
+};
+
+// Where the point lights are (--light-distance), for the light files and READMEs.
+struct PointLightSetup {
+  V3 centre;               // the scene's bounding-box centre
+  float half_diagonal = 0; // half the bounding-box diagonal
+  float distance = 0;      // of every light from the centre (--light-distance * half_diagonal)
 };
 
 struct View {
@@ -40,8 +49,12 @@ void write_text(const std::string &path, const std::string &text);
 void write_mlp(const std::string &path, const std::string &mesh_path,
                const std::vector<Photo> &photos, const std::vector<View> &views);
 void write_lp(const std::string &path, const std::vector<Photo> &photos);
+// lights_world.json: every light's description (directional; with `point`, also positions).
 void write_lights_json(const std::string &path, const std::vector<Photo> &photos,
-                       float irradiance);
+                       float irradiance, const PointLightSetup *point = nullptr);
+// lights.json, the plugin's light-position form: {"images": [...], "position_world": [...]}
+// (images named as in the .lp). Only for point lights.
+void write_positions_json(const std::string &path, const std::vector<Photo> &photos);
 
 // Binary little-endian PLY: positions and normals only (what a scanner would give).
 void write_mesh_ply(const std::string &path, const Scene &s);

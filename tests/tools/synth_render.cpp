@@ -97,9 +97,22 @@ RenderContext::RenderContext(const Scene &s) : scene(s), bvh(s.pos, s.idx) {
   ray_eps = 2e-4f * s.frame_radius;
 }
 
-bool RenderContext::lit(V3 p, V3 ng, V3 n, V3 L) const {
+LightAt light_at(const Light &light, V3 x) {
+  if (!light.point) return {light.direction, std::numeric_limits<float>::infinity(), 1.0f};
+  const V3 d = light.position - x;
+  const float dist = length(d);
+  if (!(dist > 1e-6f * light.reference_distance)) return {V3(), 0.0f, 0.0f};
+  const float ratio = light.reference_distance / dist;
+  return {d * (1.0f / dist), dist, ratio * ratio};
+}
+
+bool RenderContext::lit(V3 p, V3 ng, V3 n, V3 L, float distance) const {
   if (dot(n, L) <= 0 || dot(ng, L) <= 0) return false;
-  return !bvh.occluded(p + ng * ray_eps, L, std::numeric_limits<float>::infinity());
+  if (std::isinf(distance)) return !bvh.occluded(p + ng * ray_eps, L, distance);
+  // Point light: the segment from the offset origin to the light.
+  const V3 o = p + ng * ray_eps, d = (p + L * distance) - o;
+  const float len = length(d);
+  return !bvh.occluded(o, d * (1.0f / len), len);
 }
 
 ViewRaster rasterize(const RenderContext &ctx, const Shot &shot, int ss) {
@@ -129,8 +142,9 @@ uint8_t encode_srgb8(float v) {
 
 uint16_t encode_linear16(float v) { return uint16_t(std::lround(65535.0f * clampf(v, 0, 1))); }
 
-cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &r, const Shot &shot, V3 L,
-                     const ShadeSettings &set, uint64_t photo_key, PhotoStats &stats) {
+cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &r, const Shot &shot,
+                     const Light &light, const ShadeSettings &set, uint64_t photo_key,
+                     PhotoStats &stats) {
   const Scene &s = ctx.scene;
   const V3 eye = shot_centre(shot);
   const int ss = r.ss, sw = r.width * ss;
@@ -152,12 +166,14 @@ cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &r, const Shot &
           const float w1 = r.b1[k], w2 = r.b2[k], w0 = 1 - w1 - w2;
           const V3 P = s.pos[a] * w0 + s.pos[b] * w1 + s.pos[c] * w2;
           const V3 N = normalize(s.nrm[a] * w0 + s.nrm[b] * w1 + s.nrm[c] * w2);
-          if (!ctx.lit(P, ctx.face_normal[t], N, L)) continue;
+          const LightAt in = light_at(light, P);
+          if (in.falloff == 0 || !ctx.lit(P, ctx.face_normal[t], N, in.L, in.distance)) continue;
           const float kd = s.kd[a] * w0 + s.kd[b] * w1 + s.kd[c] * w2;
           const float ks = s.ks[a] * w0 + s.ks[b] * w1 + s.ks[c] * w2;
           const float al = s.shininess[a] * w0 + s.shininess[b] * w1 + s.shininess[c] * w2;
           const V3 C = s.color[a] * w0 + s.color[b] * w1 + s.color[c] * w2;
-          sum = sum + phong(kd, ks, al, C, N, L, normalize(eye - P), set.irradiance);
+          // Directional: falloff is exactly 1, so E * 1 keeps the bytes of the directional renders.
+          sum = sum + phong(kd, ks, al, C, N, in.L, normalize(eye - P), set.irradiance * in.falloff);
         }
       sum = sum * (1.0f / float(ss * ss));  // box filter in linear radiance, before clipping
       const float rgb[3] = {sum.x, sum.y, sum.z};

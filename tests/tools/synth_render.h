@@ -3,6 +3,7 @@
 // perspective-correct interpolation of per-vertex attributes), Phong shading, cast shadows by
 // exact ray casts, PNG encoding (8-bit sRGB or 16-bit linear).
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -14,7 +15,7 @@
 namespace synth {
 
 struct ShadeSettings {
-  float irradiance = 1.0f;  // E, white directional light
+  float irradiance = 1.0f;  // E, white light (point light: at reference_distance from it)
   bool linear16 = false;    // 16-bit linear PNG instead of 8-bit sRGB
   float noise_sigma = 0;    // Gaussian noise std-dev in linear units (0..1 = full scale)
   uint64_t seed = 1;        // noise seed
@@ -25,6 +26,26 @@ struct ShadeSettings {
 // N unit normal, L unit direction towards the light, V unit direction towards the camera centre.
 V3 phong(float kd, float ks, float shininess, V3 color, V3 N, V3 L, V3 V, float irradiance);
 
+// The light of one photo, world frame: directional (the same direction everywhere) or an
+// isotropic point light whose irradiance at x is E * (reference_distance / |position - x|)^2.
+struct Light {
+  V3 direction;                // directional: unit vector towards the light
+  bool point = false;
+  V3 position;                 // point light: where it is
+  float reference_distance = 1;  // point light: distance at which the irradiance is E (> 0)
+};
+
+// What a surface point x receives from `light`: unit direction towards it, distance to it
+// (infinity for a directional light) and the irradiance factor (1 for a directional light).
+// A point light at x itself (distance below 1e-6 reference distances) gives direction (0,0,0)
+// and factor 0: the point is not lit, never NaN.
+struct LightAt {
+  V3 L;
+  float distance;
+  float falloff;
+};
+LightAt light_at(const Light &light, V3 x);
+
 // Scene-wide data shared by all photos.
 struct RenderContext {
   RenderContext(const Scene &scene);
@@ -34,7 +55,10 @@ struct RenderContext {
   float ray_eps;                // shadow-ray origin offset along the normal (world units)
 
   // 1 when N.L > 0, the geometric normal faces the light and the ray towards it is free.
-  bool lit(V3 p, V3 geometric_normal, V3 shading_normal, V3 L) const;
+  // Directional light: unit direction L, infinite ray. With `distance` (a point light): L is
+  // the unit direction from p to the light, and the ray stops at the light.
+  bool lit(V3 p, V3 geometric_normal, V3 shading_normal, V3 L,
+           float distance = std::numeric_limits<float>::infinity()) const;
 };
 
 // Visible surface per sample of one view (ss x ss samples per pixel, box-filtered by
@@ -52,10 +76,11 @@ struct PhotoStats {
   uint64_t saturated_pixels = 0;  // covered pixels with a clipped channel
 };
 
-// One photo under a directional light (world direction towards the light), BGR, CV_8UC3 or
-// CV_16UC3. `photo_key` decorrelates the noise of different photos.
+// One photo under `light` (world frame), BGR, CV_8UC3 or CV_16UC3. Per sample: L and the
+// irradiance factor from light_at() at the interpolated position. `photo_key` decorrelates the
+// noise of different photos.
 cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &raster, const Shot &shot,
-                     V3 light_world, const ShadeSettings &settings, uint64_t photo_key,
+                     const Light &light, const ShadeSettings &settings, uint64_t photo_key,
                      PhotoStats &stats);
 
 // Encodings (value clipped to [0, 1] first).

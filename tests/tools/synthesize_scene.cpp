@@ -3,7 +3,10 @@
 //
 // Scene: a bumpy ground plate with a sphere, a torus and an open box standing on it (one mesh,
 // world +y up), spatially varying per-vertex parameters (diffuse-only and glossy regions).
-// Photos: K viewpoints (vcg::Shot cameras), N directional lights per viewpoint.
+// Photos: K viewpoints (vcg::Shot cameras), N directional lights per viewpoint; or, with
+// --light-distance D, N isotropic point lights at D bounding-box half-diagonals from the scene's
+// bounding-box centre, in the same directions (L = normalize(P - x), irradiance
+// E * (D h / |P - x|)^2 with h the half-diagonal, shadow rays stop at P).
 //
 // Model, per colour channel c (linear RGB), at a surface point with unit normal N:
 //
@@ -32,6 +35,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -60,6 +64,7 @@ struct Options {
   float azimuth = 30, elevation = 35, fov = 40;
   float offset_x = 0, offset_y = 0;
   float light_elev_min = 15, light_elev_max = 80;
+  float light_distance = 0;  // > 0: point lights, in bounding-box half-diagonals from its centre
   int threads = 0;
   bool quiet = false;
 };
@@ -82,6 +87,9 @@ const char *kUsage =
     "  --fov DEG              horizontal field of view (default 40)\n"
     "  --center-offset DX DY  principal point offset in pixels, x right, y up (default 0 0)\n"
     "  --light-elevation MIN MAX   light elevation range above the image plane (default 15 80)\n"
+    "  --light-distance D     point lights at D bounding-box half-diagonals from the box centre,\n"
+    "                         same directions, irradiance E at the centre (default 0: directional;\n"
+    "                         the fit accepts D >= 2, lights at least a half-diagonal off the box)\n"
     "  --threads T            OpenMP threads (default: all)\n"
     "  --quiet\n";
 
@@ -123,7 +131,8 @@ Options parse_options(int argc, char **argv) {
     } else if (a == "--light-elevation") {
       char **v = need(i, 2);
       o.light_elev_min = std::atof(v[0]), o.light_elev_max = std::atof(v[1]), i += 2;
-    } else if (a == "--threads") o.threads = std::atoi(*need(i, 1)), i += 1;
+    } else if (a == "--light-distance") o.light_distance = std::atof(*need(i, 1)), i += 1;
+    else if (a == "--threads") o.threads = std::atoi(*need(i, 1)), i += 1;
     else if (a == "--quiet") o.quiet = true;
     else if (a == "--help" || a == "-h") { std::cout << kUsage; std::exit(0); }
     else throw std::runtime_error("unknown option " + a);
@@ -131,8 +140,12 @@ Options parse_options(int argc, char **argv) {
   if (o.out.empty()) throw std::runtime_error("--out is required");
   if (o.vertices <= 0) o.vertices = size_vertices(o.size);
   if (o.width < 16 || o.height < 16 || o.views < 1 || o.lights < 1 || o.heldout < 0 || o.ss < 1 ||
-      o.noise < 0 || o.irradiance <= 0 || o.light_elev_min > o.light_elev_max)
+      o.noise < 0 || o.irradiance <= 0 || o.light_elev_min > o.light_elev_max ||
+      !(o.light_distance >= 0 && o.light_distance < 1e6f))
     throw std::runtime_error("invalid option value\n" + std::string(kUsage));
+  if (o.light_distance > 0 && o.light_distance <= 1)
+    throw std::runtime_error("--light-distance must be above 1 (half-diagonals of the bounding box: "
+                             "a light inside its bounding sphere may sit inside the object)");
   return o;
 }
 
@@ -145,6 +158,7 @@ std::string canonical_options(const Options &o) {
     << " --irradiance " << o.irradiance << " --ss " << o.ss << " --azimuth " << o.azimuth
     << " --elevation " << o.elevation << " --fov " << o.fov << " --center-offset " << o.offset_x
     << " " << o.offset_y << " --light-elevation " << o.light_elev_min << " " << o.light_elev_max;
+  if (o.light_distance > 0) s << " --light-distance " << o.light_distance;  // absent: directional
   return s.str();
 }
 
@@ -178,7 +192,35 @@ V3 spiral_direction(float i, int n, float el_min, float el_max, float az0) {
   return V3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
 }
 
-Photo make_photo(const View &view, int view_index, V3 d, const std::string &file) {
+// Point lights (--light-distance > 0) around the scene's bounding box; nullptr when directional.
+std::unique_ptr<PointLightSetup> point_setup(const Options &o, const Scene &s) {
+  if (!(o.light_distance > 0)) return nullptr;
+  V3 lo = s.pos.at(0), hi = s.pos.at(0);
+  for (const V3 &p : s.pos) {
+    lo = V3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z));
+    hi = V3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
+  }
+  std::unique_ptr<PointLightSetup> p(new PointLightSetup);
+  p->centre = (lo + hi) * 0.5f;
+  p->half_diagonal = 0.5f * length(hi - lo);
+  p->distance = o.light_distance * p->half_diagonal;
+  return p;
+}
+
+// The renderer's light of a photo: irradiance E at the bounding-box centre for a point light.
+Light light_of(const Photo &p, const PointLightSetup *point) {
+  Light l;
+  l.direction = p.dir_world;
+  if (p.point && point) {
+    l.point = true;
+    l.position = p.pos_world;
+    l.reference_distance = point->distance;
+  }
+  return l;
+}
+
+Photo make_photo(const View &view, int view_index, V3 d, const std::string &file,
+                 const PointLightSetup *point) {
   // Lights from below the plate would leave the scene dark: mirror them in the image plane,
   // which always brings them above the horizon (the camera looks down at the plate).
   if (camera_to_world(view.shot, d).y < 0.1f) d = V3(-d.x, -d.y, d.z);
@@ -191,6 +233,10 @@ Photo make_photo(const View &view, int view_index, V3 d, const std::string &file
   in >> p.dir_cam.x >> p.dir_cam.y >> p.dir_cam.z;
   p.dir_cam = normalize(p.dir_cam);
   p.dir_world = camera_to_world(view.shot, p.dir_cam);
+  if (point) {  // the .lp direction is the one from the bounding-box centre to the light
+    p.point = true;
+    p.pos_world = point->centre + p.dir_world * point->distance;
+  }
   return p;
 }
 
@@ -201,20 +247,20 @@ std::string photo_name(const Options &o, int view, const char *kind, int i) {
   return buf;
 }
 
-void make_photos(const Options &o, const std::vector<View> &views, std::vector<Photo> &train,
-                 std::vector<Photo> &heldout) {
+void make_photos(const Options &o, const std::vector<View> &views, const PointLightSetup *point,
+                 std::vector<Photo> &train, std::vector<Photo> &heldout) {
   const float lo = o.light_elev_min, hi = o.light_elev_max;
   for (int k = 0; k < o.views; ++k) {
     const float az0 = 10.0f + 23.0f * k;  // each view gets its own set of lights
     for (int i = 0; i < o.lights; ++i)
       train.push_back(make_photo(views[k], k, spiral_direction(float(i), o.lights, lo, hi, az0),
-                                 photo_name(o, k, "light", i)));
+                                 photo_name(o, k, "light", i), point));
     // Held-out lights: spread over the same elevations, azimuths off the training spiral, so
     // none coincides with a training light.
     for (int j = 0; j < o.heldout; ++j) {
       const float i = (j + 0.5f) * (o.lights - 1) / float(o.heldout);
       heldout.push_back(make_photo(views[k], k, spiral_direction(i, o.lights, lo, hi, az0 + 68.0f),
-                                   photo_name(o, k, "heldout", j)));
+                                   photo_name(o, k, "heldout", j), point));
     }
   }
 }
@@ -255,13 +301,24 @@ std::vector<uint8_t> vertex_visibility(const RenderContext &ctx, const View &vie
   return vis;
 }
 
-std::vector<char> vertex_lit(const RenderContext &ctx, V3 L) {
+// Per vertex: '0' N.L <= 0, 's' the ray towards the light (a point light: up to it) is blocked,
+// '1' lit. Rays start ray_eps along the vertex normal.
+std::vector<char> vertex_lit(const RenderContext &ctx, const Light &light) {
   const Scene &s = ctx.scene;
   std::vector<char> lit(s.vertex_count(), '0');
 #pragma omp parallel for schedule(dynamic, 256)
   for (long v = 0; v < long(s.vertex_count()); ++v) {
-    if (dot(s.nrm[v], L) <= 0) continue;
-    const bool blocked = ctx.bvh.occluded(s.pos[v] + s.nrm[v] * ctx.ray_eps, L, INFINITY);
+    const LightAt in = light_at(light, s.pos[v]);
+    if (in.falloff == 0 || dot(s.nrm[v], in.L) <= 0) continue;
+    const V3 o = s.pos[v] + s.nrm[v] * ctx.ray_eps;
+    bool blocked;
+    if (!light.point) {
+      blocked = ctx.bvh.occluded(o, in.L, INFINITY);
+    } else {
+      const V3 d = light.position - o;
+      const float len = length(d);
+      blocked = ctx.bvh.occluded(o, d * (1.0f / len), len);
+    }
     lit[v] = blocked ? 's' : '1';
   }
   return lit;
@@ -301,7 +358,8 @@ void write_png(const std::string &path, const cv::Mat &img) {
 std::string fraction(uint64_t a, uint64_t b) { return fmt("%.4f", b ? double(a) / b : 0.0); }
 
 std::string expected_text(const Options &o, const Scene &s, const VertexTruth &gt,
-                          const Stats &st, size_t photos, size_t heldout) {
+                          const Stats &st, size_t photos, size_t heldout,
+                          const PointLightSetup *point) {
   size_t visible = 0, diffuse = 0, glossy_visible = 0, boundary = 0;
   for (size_t v = 0; v < s.vertex_count(); ++v) {
     visible += gt.visible_any[v];
@@ -323,8 +381,14 @@ std::string expected_text(const Options &o, const Scene &s, const VertexTruth &g
     << "image_size: " << o.width << "x" << o.height << "\n"
     << "encoding: " << (o.linear16 ? "linear16" : "srgb8") << "\n"
     << "noise_sigma: " << o.noise << "\n"
-    << "irradiance: " << o.irradiance << "\n"
-    << "visible_vertices: " << visible << "\n"
+    << "irradiance: " << o.irradiance << "\n";
+  if (point)
+    e << "light_model: point\n"
+      << "light_distance_half_diagonals: " << o.light_distance << "\n"
+      << "light_distance: " << fmt("%.6g", point->distance) << "\n"
+      << "bounding_box_centre: " << fmt("%.6g", point->centre.x) << " " << fmt("%.6g", point->centre.y)
+      << " " << fmt("%.6g", point->centre.z) << "\n";
+  e << "visible_vertices: " << visible << "\n"
     << "visible_vertex_fraction: " << fraction(visible, s.vertex_count()) << "\n";
   for (size_t k = 0; k < gt.visible.size(); ++k) {
     size_t n = 0;
@@ -344,7 +408,8 @@ std::string expected_text(const Options &o, const Scene &s, const VertexTruth &g
   return e.str();
 }
 
-std::string gt_readme(const Options &o, float ray_eps, const std::vector<View> &views) {
+std::string gt_readme(const Options &o, float ray_eps, const std::vector<View> &views,
+                      const PointLightSetup *point) {
   std::ostringstream r;
   r << "# Ground truth of a synthetic capture (synthesize_scene)\n\n"
     << "Generated by `tests/tools/synthesize_scene` with `" << canonical_options(o) << "`.\n"
@@ -353,14 +418,23 @@ std::string gt_readme(const Options &o, float ray_eps, const std::vector<View> &
     << "Per colour channel c (linear RGB), at a surface point with unit normal N:\n\n"
     << "    P_c = E * ( kd * max(N.L, 0) * C_c + ks * max(R.V, 0)^shininess ) * visible_from_light\n"
     << "    R   = 2 (N.L) N - L\n\n"
-    << "* `L`: unit direction from the surface towards the light (directional light; `lights.lp`\n"
-    << "  gives it in the camera frame of the photo's view, `lights_world.json` in the world frame).\n"
+    << (point ? "* `L` = normalize(P - x): unit direction from the surface point x towards the point\n"
+                "  light at P (`lights.json` / `lights_world.json`: `position_world`). `lights.lp` gives\n"
+                "  the direction from the bounding-box centre to P, camera frame of the photo's view.\n"
+              : "* `L`: unit direction from the surface towards the light (directional light; `lights.lp`\n"
+                "  gives it in the camera frame of the photo's view, `lights_world.json` in the world frame).\n")
     << "* `V`: unit vector from the surface point to the camera centre (minus `TranslationVector`);\n"
     << "  the project specification writes it `E` (`max(R.E, 0)^alpha`): the same vector.\n"
-    << "* `E` = " << o.irradiance << ": light irradiance, white (same for every photo).\n"
+    << (point ? "* `E` = " + fmt("%g", o.irradiance) + " * (d / |P - x|)^2: irradiance of an isotropic point light, white,\n"
+                "  d = " + fmt("%.6g", point->distance) + " = " + fmt("%g", o.light_distance) +
+                " bounding-box half-diagonals: every light's distance from the bounding-box\n  centre ("
+                + fmt("%.6g", point->centre.x) + " " + fmt("%.6g", point->centre.y) + " " +
+                fmt("%.6g", point->centre.z) + "), where E = " + fmt("%g", o.irradiance) + ".\n"
+              : "* `E` = " + fmt("%g", o.irradiance) + ": light irradiance, white (same for every photo).\n")
     << "* `C`: colour, linear RGB, largest channel exactly 1; `albedo = kd * C`. The specular lobe is white.\n"
     << "* `visible_from_light` = 1 when N.L > 0, the triangle's geometric normal faces the light and\n"
-    << "  an exact ray cast from the point towards the light hits no triangle; otherwise 0.\n"
+    << "  an exact ray cast from the point towards the light hits no triangle"
+    << (point ? " before the light" : "") << "; otherwise 0.\n"
     << "* Parameter ranges: kd in [0.05, 0.9], ks in [0, 0.8], shininess in [2, 200]. Where ks = 0\n"
     << "  (diffuse-only regions) shininess is stored as 2 and has no effect.\n"
     << "* No ambient light, no interreflections, black background.\n\n"
@@ -414,19 +488,22 @@ std::string gt_readme(const Options &o, float ray_eps, const std::vector<View> &
   return r.str();
 }
 
-std::string root_readme(const Options &o, size_t photos) {
+std::string root_readme(const Options &o, size_t photos, const PointLightSetup *point) {
   std::ostringstream r;
   r << "# Synthetic capture (synthesize_scene)\n\n"
     << "Procedural object (bumpy plate, sphere, torus, open box; " << "one mesh) with known per-vertex\n"
     << "Phong reflectance, " << photos << " photos (" << o.views << " view(s) x " << o.lights
-    << " directional lights), " << o.width << "x" << o.height << ", "
+    << (point ? " point lights), " : " directional lights), ") << o.width << "x" << o.height << ", "
     << (o.linear16 ? "16-bit linear PNG" : "8-bit sRGB PNG") << ". Public domain (generated).\n\n"
     << "* `project.mlp`: MeshLab 2020.09 project (`mesh.ply` + one raster per photo).\n"
     << "* `mesh.ply`: binary PLY, positions + area-weighted vertex normals, nothing else.\n"
     << "* `images/`, `lights.lp` (N, then `images/x.png lx ly lz`, camera frame of the photo's view),\n"
-    << "  `lights_world.json`.\n"
+    << "  `lights_world.json`" << (point ? "; `lights.json`: the light positions (world frame, mesh\n"
+                                         "  units) in the form the fit reads (`vbrdf_fit --lp lights.json`).\n"
+                                       : ".\n")
     << "* `heldout/`: extra photos under lights that are NOT in `project.mlp` (own `project.mlp`,\n"
-    << "  `lights.lp`, `lights_world.json`; paths relative to `heldout/`).\n"
+    << "  `lights.lp`, `lights_world.json`" << (point ? ", `lights.json`" : "")
+    << "; paths relative to `heldout/`).\n"
     << "* `ground_truth/`: model, conventions and per-vertex truth (`README.md`).\n"
     << "* `expected.txt`: figures of this capture (key: value).\n\n"
     << "Regenerate: `synthesize_scene " << canonical_options(o) << " --out <dir>`.\n";
@@ -445,8 +522,9 @@ int main(int argc, char **argv) {
     const Scene s = make_scene(o.vertices);
     const RenderContext ctx(s);
     const std::vector<View> views = make_views(o, s);
+    const std::unique_ptr<PointLightSetup> point = point_setup(o, s);
     std::vector<Photo> train, held;
-    make_photos(o, views, train, held);
+    make_photos(o, views, point.get(), train, held);
 
     // Ground truth first: the sample statistics read the rendered pixels of visible vertices.
     VertexTruth gt;
@@ -456,8 +534,8 @@ int main(int argc, char **argv) {
       gt.visible.push_back(vertex_visibility(ctx, views[k], pixel[k]));
       for (size_t v = 0; v < s.vertex_count(); ++v) gt.visible_any[v] |= gt.visible[k][v];
     }
-    for (const Photo &p : train) gt.lit.push_back(vertex_lit(ctx, p.dir_world));
-    for (const Photo &p : held) gt.lit_heldout.push_back(vertex_lit(ctx, p.dir_world));
+    for (const Photo &p : train) gt.lit.push_back(vertex_lit(ctx, light_of(p, point.get())));
+    for (const Photo &p : held) gt.lit_heldout.push_back(vertex_lit(ctx, light_of(p, point.get())));
 
     make_dirs(out + "/images");
     make_dirs(out + "/ground_truth");
@@ -481,7 +559,7 @@ int main(int argc, char **argv) {
         const bool is_train = &p >= train.data() && &p < train.data() + train.size();
         const size_t i = is_train ? size_t(&p - train.data()) : size_t(&p - held.data());
         PhotoStats px;
-        const cv::Mat img = render_photo(ctx, raster, views[k].shot, p.dir_world, set,
+        const cv::Mat img = render_photo(ctx, raster, views[k].shot, light_of(p, point.get()), set,
                                          is_train ? i : 100000 + i, px);
         if (is_train) {
           photo_stats[i].pixels = px;
@@ -503,20 +581,22 @@ int main(int argc, char **argv) {
     write_mesh_ply(out + "/mesh.ply", s);
     write_mlp(out + "/project.mlp", "mesh.ply", train, views);
     write_lp(out + "/lights.lp", train);
-    write_lights_json(out + "/lights_world.json", train, o.irradiance);
+    write_lights_json(out + "/lights_world.json", train, o.irradiance, point.get());
+    if (point) write_positions_json(out + "/lights.json", train);
     if (!held.empty()) {
       write_mlp(out + "/heldout/project.mlp", "../mesh.ply", held, views);
       write_lp(out + "/heldout/lights.lp", held);
-      write_lights_json(out + "/heldout/lights_world.json", held, o.irradiance);
+      write_lights_json(out + "/heldout/lights_world.json", held, o.irradiance, point.get());
+      if (point) write_positions_json(out + "/heldout/lights.json", held);
     }
     write_gt_ply(out + "/ground_truth/gt_vertex.ply", s, gt);
     write_gt_csv(out + "/ground_truth/gt_vertex.csv", s, gt);
     write_lit_table(out + "/ground_truth/gt_lit.txt", train, gt.lit, s.vertex_count());
     write_lit_table(out + "/ground_truth/gt_lit_heldout.txt", held, gt.lit_heldout, s.vertex_count());
-    const std::string expected = expected_text(o, s, gt, st, train.size(), held.size());
+    const std::string expected = expected_text(o, s, gt, st, train.size(), held.size(), point.get());
     write_text(out + "/expected.txt", expected);
-    write_text(out + "/ground_truth/README.md", gt_readme(o, ctx.ray_eps, views));
-    write_text(out + "/README.md", root_readme(o, train.size()));
+    write_text(out + "/ground_truth/README.md", gt_readme(o, ctx.ray_eps, views, point.get()));
+    write_text(out + "/README.md", root_readme(o, train.size(), point.get()));
 
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!o.quiet)
