@@ -38,7 +38,7 @@ generate() {  # NAME SYNTH_ARGS...
   "$SYNTH" --quiet --out "$new" "$@"
   mkdir -p "$dest"
   rm -rf "$dest/images" "$dest/heldout" "$dest/ground_truth" "$dest/project.mlp" "$dest/mesh.ply" \
-         "$dest/lights.lp" "$dest/lights_world.json" "$dest/README.md"
+         "$dest/lights.lp" "$dest/lights.json" "$dest/lights_world.json" "$dest/README.md"
   if [ -f "$dest/expected.txt" ]; then
     merge_expected "$new/expected.txt" "$dest/expected.txt" > "$TMP/expected.txt"
     mv "$TMP/expected.txt" "$new/expected.txt"
@@ -82,5 +82,6 @@ mkdir -p "$OUT"
 generate synth_basic --size small --lights 16 --heldout 4
 generate synth_two_views --size small --views 2 --lights 8 --heldout 2
 generate synth_linear16 --size small --lights 8 --heldout 2 --linear16 --width 480 --height 360
+generate synth_near_lights --size small --lights 16 --heldout 4 --light-distance 3
 copy_spot
 echo "sample_projects: $(du -sh "$OUT" | cut -f1) in total, $((SECONDS - start)) s"
