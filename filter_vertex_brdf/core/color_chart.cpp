@@ -445,24 +445,11 @@ cv::Mat linear_rgb_image(const cv::Mat &image, bool bgr, bool decode_srgb) {
   else if (image.channels() == 4) cv::cvtColor(image, c3, bgr ? cv::COLOR_BGRA2BGR : cv::COLOR_RGBA2RGB);
   else c3 = image;
   if (bgr) cv::cvtColor(c3, c3, cv::COLOR_BGR2RGB);
-  cv::Mat f;
-  if (c3.depth() == CV_8U && decode_srgb) {
-    cv::Mat lut(1, 256, CV_32FC3);
-    for (int i = 0; i < 256; ++i) {
-      const float v = srgb_to_linear(float(i) / 255.0f);
-      lut.at<cv::Vec3f>(i) = cv::Vec3f(v, v, v);
-    }
-    cv::LUT(c3, lut, f);
-  } else if (c3.depth() == CV_8U) {
-    c3.convertTo(f, CV_32FC3, 1.0 / 255);
-  } else if (c3.depth() == CV_16U) {
-    c3.convertTo(f, CV_32FC3, 1.0 / 65535);
-  } else if (c3.depth() == CV_32F || c3.depth() == CV_64F) {
-    c3.convertTo(f, CV_32FC3);
-  } else {
-    throw InputError("Colour chart: unsupported photo depth (expected 8-bit, 16-bit or float)");
+  try {
+    return decode_to_linear(c3, decode_srgb);
+  } catch (const InputError &e) {
+    throw InputError(std::string("Colour chart: ") + e.what());
   }
-  return f;
 }
 
 std::vector<ChartLocation> detect_charts(const cv::Mat &bgr8, int max_charts, std::vector<std::string> &log) {

@@ -1,4 +1,5 @@
 #include "color_difference.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +7,6 @@
 namespace vbrdf {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kSrgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
                                      {0.2126729, 0.7151522, 0.0721750},
                                      {0.0193339, 0.1191920, 0.9503041}};

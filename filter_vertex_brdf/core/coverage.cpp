@@ -1,4 +1,5 @@
 #include "coverage.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +11,8 @@
 namespace vbrdf {
 
 namespace {
-constexpr float kPi = 3.14159265358979f;
-constexpr float kDeg = kPi / 180.0f;
+constexpr float kPiF = float(kPi);  // float maths here
+constexpr float kDeg = kPiF / 180.0f;
 
 struct V3 {
   float x, y, z;
@@ -201,11 +202,11 @@ public:
 private:
   int lat_index(V3 l) const {
     const float lat = std::asin(std::max(-1.0f, std::min(1.0f, l.z)));  // elevation
-    return std::min(parts_ - 1, std::max(0, int((lat / kPi + 0.5f) * parts_)));
+    return std::min(parts_ - 1, std::max(0, int((lat / kPiF + 0.5f) * parts_)));
   }
   int lon_index(V3 l) const {
     const float lon = std::atan2(l.y, l.x);
-    return std::min(parts_ - 1, std::max(0, int((lon / (2 * kPi) + 0.5f) * parts_)));
+    return std::min(parts_ - 1, std::max(0, int((lon / (2 * kPiF) + 0.5f) * parts_)));
   }
   int parts_;
   std::vector<V3> sum_;

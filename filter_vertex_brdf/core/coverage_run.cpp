@@ -17,21 +17,14 @@
 #include "file_util.h"
 #include "light_file.h"
 #include "output_ply.h"
+#include "vec3.h"
 
 namespace vbrdf {
 
 namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-constexpr float kPi = 3.14159265358979f;
 
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 std::string percent(size_t part, size_t whole) {
   return whole ? fixed(100.0 * double(part) / double(whole), 1) + "%" : "0%";
@@ -41,7 +34,6 @@ std::string vec3(const float v[3], int digits = 4) {
   return fixed(v[0], digits) + " " + fixed(v[1], digits) + " " + fixed(v[2], digits);
 }
 
-float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // A mesh normal, normalised (file normals need not be unit length).
 void unit_normal(const float *n, float out[3]) {
@@ -370,27 +362,6 @@ std::vector<uint8_t> new_view_reasons(const MeshView &mesh, const std::vector<ui
   return reasons;
 }
 
-std::vector<Viewpoint> group_viewpoints(const std::vector<Raster> &rasters) {
-  std::vector<Viewpoint> out;
-  for (size_t r = 0; r < rasters.size(); ++r) {
-    auto it = std::find_if(out.begin(), out.end(), [&](const Viewpoint &v) { return same_shot(v.shot, rasters[r].shot); });
-    if (it == out.end()) {
-      out.push_back(Viewpoint{rasters[r].shot, {}});
-      it = out.end() - 1;
-    }
-    it->rasters.push_back(r);
-  }
-  return out;
-}
-
-size_t viewpoint_of_raster(const std::vector<Viewpoint> &viewpoints, size_t raster) {
-  for (size_t i = 0; i < viewpoints.size(); ++i)
-    if (std::find(viewpoints[i].rasters.begin(), viewpoints[i].rasters.end(), raster) != viewpoints[i].rasters.end())
-      return i;
-  throw InputError("Raster " + std::to_string(raster) + " does not exist: choose a raster index between 0 and the "
-                   "number of rasters minus one (-1 = the last raster).");
-}
-
 std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &rasters, const std::string &lp_path,
                                                      std::vector<std::string> *unused) {
   const std::vector<LightEntry> lights = read_light_file(lp_path);
@@ -423,7 +394,7 @@ LightSuggestion suggest_light_with_tolerance(const MeshView &mesh, const Shot &v
       tight.specular_threshold = std::cos(std::max(0.0f, ts - tol));
     } else {
       tight.diffuse_threshold = std::cos(std::max(0.0f, td - tol));
-      tight.specular_threshold = std::cos(std::min(kPi / 2, ts + tol));
+      tight.specular_threshold = std::cos(std::min(float(kPi / 2), ts + tol));
     }
     LightSuggestion robust = suggest(mesh, viewpoint, visible, needs, kind, tight);
     if (robust.valid) {

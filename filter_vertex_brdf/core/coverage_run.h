@@ -23,22 +23,10 @@
 #include "pipeline.h"
 #include "samples.h"
 #include "sphere_lights.h"
+#include "viewpoints.h"
 #include "visibility.h"
 
 namespace vbrdf {
-
-struct Viewpoint {
-  Shot shot;                    // the shared registration (that of its first raster)
-  std::vector<size_t> rasters;  // indices into the raster list, ascending
-};
-
-// Groups rasters whose shots are identical (intrinsics and extrinsics equal to 1e-6 relative),
-// in order of first appearance. Every raster belongs to exactly one viewpoint.
-std::vector<Viewpoint> group_viewpoints(const std::vector<Raster> &rasters);
-
-// Index of the viewpoint holding raster `raster` (viewpoints from group_viewpoints). Throws
-// InputError when no viewpoint holds it.
-size_t viewpoint_of_raster(const std::vector<Viewpoint> &viewpoints, size_t raster);
 
 // Lenient light lookup for an acquisition in progress: every raster needs an entry in `lp_path`
 // (InputError naming the .lp and the raster otherwise); entries for photos not imported yet are

@@ -12,7 +12,7 @@
 #include <cstddef>
 #include <string>
 
-#include "visibility_gl.h"  // GetProcAddressFn
+#include "gl_context.h"  // GetProcAddressFn
 
 // OpenGL 3.3 core: required by every pass.
 #define VBRDF_GL_CORE_33(X)                                                                        \

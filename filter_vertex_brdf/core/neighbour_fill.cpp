@@ -1,4 +1,5 @@
 #include "neighbour_fill.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <cmath>
@@ -49,7 +50,6 @@ Adjacency build_adjacency(const MeshView &mesh) {
   return adj;
 }
 
-float dot3(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // The weighted average of the modelled neighbours of v (model[u] != 0); false when there is none.
 bool average_of_neighbours(const MeshView &mesh, const Adjacency &adj, const std::vector<uint8_t> &model,

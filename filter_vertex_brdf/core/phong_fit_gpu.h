@@ -15,7 +15,7 @@
 
 #include "phong_fit.h"
 #include "samples.h"
-#include "visibility_gl.h"  // GetProcAddressFn
+#include "gl_context.h"  // GetProcAddressFn
 
 namespace vbrdf {
 

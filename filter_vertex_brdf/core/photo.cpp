@@ -86,6 +86,53 @@ PixelSample bilinear(const Photo &photo, float x, float y, uint8_t texels) {
 }
 } // namespace
 
+cv::Mat photo_linear_rgb(const Photo &photo, cv::Mat *clipped) {
+  const int w = photo.width(), h = photo.height();
+  cv::Mat linear(h, w, CV_32FC3);
+  if (clipped) clipped->create(h, w, CV_8U);
+  const bool wide = photo.pixels.depth() == CV_16U;
+  for (int y = 0; y < h; ++y) {
+    float *out = linear.ptr<float>(y);
+    uint8_t *clip = clipped ? clipped->ptr<uint8_t>(y) : nullptr;
+    for (int x = 0; x < w; ++x) {
+      bool any = false;
+      for (int c = 0; c < 3; ++c) {
+        const int code = wide ? photo.pixels.ptr<uint16_t>(y)[3 * x + c] : photo.pixels.ptr<uint8_t>(y)[3 * x + c];
+        out[3 * x + c] = photo.lut[size_t(code)];
+        any = any || code >= photo.saturation_code;
+      }
+      if (clip) clip[x] = any ? 255 : 0;
+    }
+  }
+  return linear;
+}
+
+cv::Mat decode_to_linear(const cv::Mat &image, bool decode_srgb) {
+  if (image.empty()) return cv::Mat();
+  cv::Mat f;
+  if (image.depth() == CV_8U && decode_srgb) {
+    cv::Mat lut(1, 256, CV_32F);
+    for (int i = 0; i < 256; ++i) lut.at<float>(i) = srgb_to_linear(float(i) / 255.0f);
+    std::vector<cv::Mat> planes, decoded;
+    cv::split(image, planes);
+    for (const cv::Mat &p : planes) {
+      cv::Mat d;
+      cv::LUT(p, lut, d);
+      decoded.push_back(d);
+    }
+    cv::merge(decoded, f);
+  } else if (image.depth() == CV_8U) {
+    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()), 1.0 / 255);
+  } else if (image.depth() == CV_16U) {
+    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()), 1.0 / 65535);
+  } else if (image.depth() == CV_32F || image.depth() == CV_64F) {
+    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()));
+  } else {
+    throw InputError("Unsupported image depth: expected 8-bit, 16-bit or float.");
+  }
+  return f;
+}
+
 PixelSample sample_bilinear(const Photo &photo, float x, float y, uint8_t texels) {
   if (!std::isfinite(x) || !std::isfinite(y)) return PixelSample();
   return photo.pixels.depth() == CV_16U ? bilinear<uint16_t>(photo, x, y, texels)

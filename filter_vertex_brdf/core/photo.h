@@ -34,6 +34,17 @@ struct Photo {
 Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level = 0.99f,
                  int expected_width = 0, int expected_height = 0);
 
+// The photo as linear RGB float (CV_32FC3, its own decoding table: exactly the values its samples
+// get) and, when `clipped` is given, a CV_8U mask of its clipped pixels (255 where any channel is
+// at or above the saturation code).
+cv::Mat photo_linear_rgb(const Photo &photo, cv::Mat *clipped = nullptr);
+
+// Any image (8-bit, 16-bit or float; any channel count) as float in [0, 1] with its channels kept:
+// 8-bit decoded as sRGB when `decode_srgb` (else / 255), 16-bit / 65535 (linear), float as is.
+// The one decoding of images that are not Photos (colour charts, spheres). Throws InputError for
+// another depth; an empty image gives an empty result.
+cv::Mat decode_to_linear(const cv::Mat &image, bool decode_srgb);
+
 struct PixelSample {
   float rgb[3] = {0, 0, 0};  // linear
   bool inside = false;       // the bilinear footprint is inside the image

@@ -9,11 +9,13 @@
 #include "errors.h"
 #include "file_util.h"
 #include "light_file.h"
+#include "color_plan.h"
 #include "light_source.h"
 #include "output_ply.h"
 #include "phong_fit_gpu.h"
 #include "result_schema.h"
 #include "visibility_gl.h"
+#include "vec3.h"
 
 namespace vbrdf {
 
@@ -21,13 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-std::string fixed(double v, int digits = 2) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 std::string percent(uint64_t part, uint64_t whole) {
   return whole ? fixed(100.0 * double(part) / double(whole), 1) + "%" : "0%";
@@ -48,17 +43,6 @@ int bit(uint16_t flag) {
 std::string default_output_path(const std::string &project_path) {
   if (project_path.empty()) return "vertex_brdf.ply";
   return strip_extension(project_path) + "_brdf.ply";
-}
-
-std::vector<std::vector<size_t>> rasters_by_viewpoint(const std::vector<Raster> &rasters) {
-  std::vector<std::vector<size_t>> groups;
-  for (size_t r = 0; r < rasters.size(); ++r) {
-    const auto same = [&](const std::vector<size_t> &g) { return same_shot(rasters[g.front()].shot, rasters[r].shot); };
-    auto it = std::find_if(groups.begin(), groups.end(), same);
-    if (it == groups.end()) it = groups.insert(groups.end(), std::vector<size_t>());
-    it->push_back(r);
-  }
-  return groups;
 }
 
 void validate_input(const FitInput &input) {
@@ -130,117 +114,22 @@ private:
 
 // ---- Colour correction (color_chart.h), per viewpoint ----
 
-// Where each raster's samples find their correction.
-struct ColorPlan {
-  std::vector<ColorCalibration> viewpoints;
-  std::vector<uint32_t> viewpoint_of, photo_of;  // per raster: viewpoint, index among its photos
-  bool any_corrected() const {
-    return std::any_of(viewpoints.begin(), viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; });
-  }
-};
-
-// Linear RGB float through the photo's own table, so the chart is measured exactly as the samples are.
-template <typename T>
-cv::Mat decode_linear(const Photo &photo) {
-  cv::Mat out(photo.pixels.size(), CV_32FC3);
-  for (int y = 0; y < out.rows; ++y) {
-    const T *in = photo.pixels.ptr<T>(y);
-    float *o = out.ptr<float>(y);
-    for (int i = 0; i < 3 * out.cols; ++i) o[i] = photo.lut[in[i]];
-  }
-  return out;
-}
-
-cv::Mat linear_rgb_of(const Photo &photo) {
-  return photo.pixels.depth() == CV_16U ? decode_linear<uint16_t>(photo) : decode_linear<uint8_t>(photo);
-}
-
-std::string viewpoint_name(const FitInput &input, const std::vector<size_t> &group, size_t v, size_t count) {
-  return "Viewpoint " + std::to_string(v + 1) + " of " + std::to_string(count) + " (" + std::to_string(group.size()) +
-         " photo(s), first raster '" + input.rasters[group.front()].label + "')";
-}
-
-// Chart settings of viewpoint `v`: detection, or its corners (8 numbers shared by all viewpoints,
-// or 8 per viewpoint).
-ColorSettings color_settings_for(const FitSettings &settings, size_t v, size_t viewpoints) {
-  const std::vector<float> &corners = settings.chart_corners;
-  if (!corners.empty() && corners.size() != 8 && corners.size() != 8 * viewpoints)
-    throw InputError("Parameter 'chartCorners' has " + std::to_string(corners.size()) + " numbers; give 8 (x y of "
-                     "the dark skin, bluish green, black and white patch centres) for all viewpoints, or 8 per "
-                     "viewpoint (the project has " + std::to_string(viewpoints) + "), or leave it empty to detect "
-                     "the chart.");
-  ColorSettings s;
-  s.require_chart = settings.color_correction == ColorCorrectionChoice::Required;
-  s.exposure = settings.exposure;
-  s.manual = !corners.empty();
-  const size_t first = corners.size() == 8 ? 0 : 8 * v;
-  if (s.manual) std::copy(corners.begin() + long(first), corners.begin() + long(first + 8), s.corners);
-  return s;
-}
-
-ColorCalibration calibrate_viewpoint(const FitInput &input, const ColorSettings &settings,
-                                     const std::vector<size_t> &group,
-                                     const std::vector<std::array<float, 3>> &lights_world, PhotoCache &photos,
-                                     const std::string &where) {
-  std::vector<std::string> names;
-  std::vector<std::array<double, 3>> lights_cam;  // calibrate_colors tells varying intensity from the chart's angle
-  for (size_t r : group) {
-    names.push_back(input.rasters[r].label);  // the core quotes it
-    float cam[3];
-    world_to_camera_direction(input.rasters[r].shot, lights_world[r].data(), cam);
-    lights_cam.push_back({{cam[0], cam[1], cam[2]}});
-  }
-  const RgbLoader load = [&](size_t i) {
-    const Raster &r = input.rasters[group[i]];
-    return linear_rgb_of(*photos.get(r.image_path, r.width(), r.height()));
-  };
-  try {
-    return calibrate_colors(group.size(), load, settings, &lights_cam, names);
-  } catch (const InputError &e) {
-    throw InputError("Colour correction is required (colorCorrection = Required) but failed. " + where + ": " +
-                     e.what() + " Set 'chartCorners', or set 'colorCorrection' to Auto to fit without correction.");
-  }
-}
-
-// Calibrates every viewpoint and logs what was found; InputError when Required and a chart is missing.
+// Every viewpoint's colour correction (color_plan.h), photos decoded as their samples are.
 ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
                       const std::vector<std::array<float, 3>> &lights_world, PhotoCache &photos, const LogFn &log) {
-  ColorPlan plan;
   if (settings.color_correction == ColorCorrectionChoice::Off) {
     log("Colour correction: off (colorCorrection = Off): samples are used as decoded.");
-    return plan;
+    return ColorPlan();
   }
-  const std::vector<std::vector<size_t>> groups = rasters_by_viewpoint(input.rasters);
-  plan.viewpoint_of.resize(input.rasters.size());
-  plan.photo_of.resize(input.rasters.size());
-  for (size_t v = 0; v < groups.size(); ++v) {
-    const std::string where = viewpoint_name(input, groups[v], v, groups.size());
-    const ColorSettings cs = color_settings_for(settings, v, groups.size());
-    plan.viewpoints.push_back(calibrate_viewpoint(input, cs, groups[v], lights_world, photos, where));
-    const ColorCalibration &cal = plan.viewpoints.back();
-    for (size_t i = 0; i < groups[v].size(); ++i) {
-      plan.viewpoint_of[groups[v][i]] = uint32_t(v);
-      plan.photo_of[groups[v][i]] = uint32_t(i);
-    }
-    for (const std::string &line : cal.log) log(where + ": " + line);
-    if (!cal.corrected)
-      log(where + ": colour correction: " + (cal.patches.empty() ? "no chart found" : "chart not usable") +
-          ": colours uncorrected.");
-  }
-  return plan;
-}
-
-// In place, before any estimate: corrected = M(rgb / exposure). Negative results (a matrix
-// applied to noise in dark pixels) are no light: clamped to 0.
-void correct_colors(const ColorPlan &plan, SampleChunk &chunk) {
-#pragma omp parallel for schedule(static)
-  for (long long i = 0; i < (long long)chunk.samples.size(); ++i) {
-    Sample &s = chunk.samples[size_t(i)];
-    const ColorCalibration &cal = plan.viewpoints[plan.viewpoint_of[s.raster]];
-    if (!cal.corrected) continue;
-    apply_color_calibration(cal, plan.photo_of[s.raster], s.rgb);
-    for (float &c : s.rgb) c = c > 0 ? c : 0.0f;  // also NaN -> 0
-  }
+  ColorCorrectionSettings cs;
+  cs.choice = settings.color_correction;
+  cs.exposure = settings.exposure;
+  cs.chart_corners = settings.chart_corners;
+  const auto load = [&](size_t r) {
+    const Raster &raster = input.rasters[r];
+    return photo_linear_rgb(*photos.get(raster.image_path, raster.width(), raster.height()));
+  };
+  return plan_color_correction(input.rasters, lights_world, cs, load, log);
 }
 
 std::string color_report(const FitResult &r, const FitSettings &settings) {
@@ -525,7 +414,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   result.gather = gather_samples(
       mesh, input.rasters, lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
-        if (correct) correct_colors(colors, chunk);
+        if (correct) correct_samples(colors, chunk);
         apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
         consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
       },

@@ -10,12 +10,14 @@
 #include <vector>
 
 #include "color_chart.h"
+#include "color_plan.h"  // ColorCorrectionChoice: Off, Auto (where a chart is found), Required
 #include "diffuse_color.h"
 #include "neighbour_fill.h"
 #include "phong_fit.h"
 #include "mesh_view.h"
 #include "output_ply.h"
 #include "samples.h"
+#include "viewpoints.h"
 #include "visibility.h"
 
 namespace vbrdf {
@@ -25,8 +27,6 @@ using LogFn = std::function<void(const std::string &line)>;
 enum class VisibilityChoice { Auto = 0, GL = 1, CPU = 2 };
 enum class FitBackendChoice { Auto = 0, GPU = 1, CPU = 2 };
 enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
-// Off: samples as decoded; Auto: corrected where a chart is found; Required: no chart is an error.
-enum class ColorCorrectionChoice { Off = 0, Auto = 1, Required = 2 };
 
 // The fit's T_d (N.L below which a sample is "grazing"): 0.2, not the thesis's 0.5. With errors
 // weighted by N.L, grazing samples help more than they hurt: over the whole visible surface the
@@ -69,9 +69,6 @@ struct FitInput {
 };
 
 
-// Rasters grouped by viewpoint: photos of one viewpoint share one registration (an identical shot,
-// equal to 1e-6 relative). Groups are in order of their first raster; indices ascending.
-std::vector<std::vector<size_t>> rasters_by_viewpoint(const std::vector<Raster> &rasters);
 
 // Checks everything that can be checked before any work: non-empty mesh with normals, at least
 // one raster, every raster with a valid shot and an existing photo of the shot's size.

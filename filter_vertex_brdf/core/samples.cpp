@@ -5,17 +5,11 @@
 #include <cmath>
 
 #include "errors.h"
+#include "vec3.h"
 
 namespace vbrdf {
 
 namespace {
-inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-inline void normalize3(float v[3]) {
-  const float len = std::sqrt(dot3(v, v));
-  if (len > 0)
-    for (int k = 0; k < 3; ++k) v[k] /= len;
-}
 
 void report(const ProgressFn &progress, float fraction, const char *stage) {
   if (progress && !progress(std::min(std::max(fraction, 0.0f), 1.0f), stage))

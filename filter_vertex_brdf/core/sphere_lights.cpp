@@ -10,12 +10,12 @@
 
 #include "errors.h"
 #include "photo.h"
+#include "vec3.h"
 
 namespace vbrdf {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // --- Constants of detect_spheres (lengths in full-resolution image pixels unless said) ---------
 // Bright spots: the brightest local maxima of each photo, where a mirror sphere's highlight is.
@@ -62,19 +62,6 @@ constexpr double kNestedOuterMinScore = 0.3;
 constexpr double kNestedSlackPx = 1;      // "inside" allows this much overlap
 constexpr double kFinalRefineShiftPx = 2.0;  // refine_sphere's search range for the final outline
 
-double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-void normalize3(double v[3]) {
-  const double n = std::sqrt(dot3(v, v));
-  if (n > 0)
-    for (int i = 0; i < 3; ++i) v[i] /= n;
-}
-
-void cross3(const double a[3], const double b[3], double out[3]) {
-  out[0] = a[1] * b[2] - a[2] * b[1];
-  out[1] = a[2] * b[0] - a[0] * b[2];
-  out[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 std::string fmt(const char *format, double a = 0, double b = 0, double c = 0, double d = 0) {
   char buf[256];
@@ -626,18 +613,10 @@ double angle_deg(const double a[3], const double b[3]) {
 cv::Mat gray_image(const cv::Mat &image, bool decode_srgb) {
   if (image.empty()) return cv::Mat();
   cv::Mat f;
-  if (image.depth() == CV_8U && decode_srgb) {
-    // 8-bit photos are sRGB-encoded: decode so that intensities add like light.
-    cv::Mat lut(1, 256, CV_32F);
-    for (int i = 0; i < 256; ++i) lut.at<float>(i) = srgb_to_linear(float(i) / 255.0f);
-    cv::LUT(image, lut, f);
-  } else {
-    double scale = 1;
-    if (image.depth() == CV_8U) scale = 1.0 / 255;
-    else if (image.depth() == CV_16U) scale = 1.0 / 65535;
-    else if (image.depth() != CV_32F && image.depth() != CV_64F)
-      throw InputError("Sphere detection: unsupported image depth (expected 8-bit, 16-bit or float)");
-    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()), scale);
+  try {
+    f = decode_to_linear(image, decode_srgb);  // 8-bit photos are sRGB: decoded so that intensities add like light
+  } catch (const InputError &e) {
+    throw InputError(std::string("Sphere detection: ") + e.what());
   }
   if (f.channels() == 1) return f;
   std::vector<cv::Mat> ch;

@@ -5,11 +5,10 @@
 #include <functional>
 #include <memory>
 
+#include "gl_context.h"
 #include "visibility.h"
 
 namespace vbrdf {
-
-using GetProcAddressFn = std::function<void *(const char *name)>;
 
 // Requires a current OpenGL >= 3.3 context (core or compatibility) for the whole lifetime of the
 // returned object. Throws ProcessingError (naming the missing entry point or GL error) when the

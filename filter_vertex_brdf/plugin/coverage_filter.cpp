@@ -22,15 +22,25 @@ const char *const kPoorSpecularQuality = "poorSpecularQuality";
 const char *const kColorByCoverage = "colorByCoverage";
 const char *const kSelectNewView = "selectNewViewVertices";
 
+// The per-vertex attributes coverage adds to the mesh: each name beside the value it holds.
+struct CoverageColumn {
+  const char *name;
+  float (*value)(const vbrdf::CoverageResult &r, size_t v);
+};
+const CoverageColumn kCoverageColumns[] = {
+    {"coverage_class", [](const vbrdf::CoverageResult &r, size_t v) { return float(r.classes[v]); }},
+    {"coverage_seen", [](const vbrdf::CoverageResult &r, size_t v) { return float(r.counts[v].seen); }},
+    {"coverage_diffuse", [](const vbrdf::CoverageResult &r, size_t v) { return float(r.counts[v].diffuse); }},
+    {"coverage_specular", [](const vbrdf::CoverageResult &r, size_t v) { return float(r.counts[v].specular); }},
+};
+
 std::vector<vbrdf::VertexAttribute> coverage_attributes(const vbrdf::CoverageResult &r) {
-  std::vector<vbrdf::VertexAttribute> attrs = {
-      {"coverage_class", {}}, {"coverage_seen", {}}, {"coverage_diffuse", {}}, {"coverage_specular", {}}};
-  for (auto &a : attrs) a.values.reserve(r.classes.size());
-  for (size_t v = 0; v < r.classes.size(); ++v) {
-    attrs[0].values.push_back(float(r.classes[v]));
-    attrs[1].values.push_back(float(r.counts[v].seen));
-    attrs[2].values.push_back(float(r.counts[v].diffuse));
-    attrs[3].values.push_back(float(r.counts[v].specular));
+  std::vector<vbrdf::VertexAttribute> attrs;
+  for (const CoverageColumn &column : kCoverageColumns) {
+    vbrdf::VertexAttribute a{column.name, {}};
+    a.values.reserve(r.classes.size());
+    for (size_t v = 0; v < r.classes.size(); ++v) a.values.push_back(column.value(r, v));
+    attrs.push_back(std::move(a));
   }
   return attrs;
 }

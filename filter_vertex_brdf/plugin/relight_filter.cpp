@@ -68,11 +68,7 @@ RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &pa
   require(std::isfinite(s.output.heat_map_max_de) && s.output.heat_map_max_de > 0 && s.output.heat_map_max_de <= 100,
           kHeatMapMax, "must be in (0, 100]");
   s.output.encoding = shared::photo_encoding(params);
-  static_assert(int(vbrdf::RelightColorCorrection::Off) == int(vbrdf::ColorCorrectionChoice::Off) &&
-                    int(vbrdf::RelightColorCorrection::Auto) == int(vbrdf::ColorCorrectionChoice::Auto) &&
-                    int(vbrdf::RelightColorCorrection::Required) == int(vbrdf::ColorCorrectionChoice::Required),
-                "relight's colour correction choices follow the fit's");
-  s.output.color_correction = vbrdf::RelightColorCorrection(int(shared::color_correction(params)));
+  s.output.color_correction = shared::color_correction(params);
   s.output.chart_corners = shared::chart_corners(params);
   s.output.exposure = shared::exposure_normalisation(params);
   s.render.shadow_map_size = shared::shadow_map_size(params);

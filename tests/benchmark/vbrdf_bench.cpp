@@ -47,7 +47,9 @@
 #include "pipeline.h"
 #include "project.h"
 #include "relight.h"
+#include "orbit_camera.h"
 #include "relight_render.h"
+#include "relight_report.h"
 #include "result_ply.h"
 #include "visibility_gl.h"
 

@@ -246,7 +246,7 @@ TEST(RelightSettingsFrom, DefaultsAndEveryParameter) {
   EXPECT_TRUE(d.render_rasters);
   EXPECT_FALSE(d.novel_view);
   EXPECT_EQ(d.render.shadow_map_size, 0);
-  EXPECT_EQ(d.output.color_correction, vbrdf::RelightColorCorrection::Auto);
+  EXPECT_EQ(d.output.color_correction, vbrdf::ColorCorrectionChoice::Auto);
   EXPECT_EQ(d.output.encoding, vbrdf::PhotoEncoding::Auto);
   EXPECT_FLOAT_EQ(d.output.heat_map_max_de, vbrdf::RelightOutputOptions().heat_map_max_de);
 
@@ -284,7 +284,7 @@ TEST(RelightSettingsFrom, DefaultsAndEveryParameter) {
   EXPECT_NEAR(s.novel_light[2], 0.8f, 1e-6f);
   EXPECT_FLOAT_EQ(s.output.heat_map_max_de, 5.0f);
   EXPECT_EQ(s.output.encoding, vbrdf::PhotoEncoding::SRGB);
-  EXPECT_EQ(s.output.color_correction, vbrdf::RelightColorCorrection::Off);
+  EXPECT_EQ(s.output.color_correction, vbrdf::ColorCorrectionChoice::Off);
   EXPECT_EQ(s.output.chart_corners.size(), 8u);
   EXPECT_EQ(s.output.exposure, vbrdf::ExposureMode::Off);
   EXPECT_EQ(s.render.shadow_map_size, 256);

@@ -16,7 +16,9 @@
 #include "errors.h"
 #include "file_util.h"
 #include "osmesa_context.h"
+#include "orbit_camera.h"
 #include "relight_render.h"
+#include "relight_report.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 
@@ -66,56 +68,25 @@ size_t count_class(const RelitImage &r, uint8_t cls) {
 const float *pixel(const RelitImage &r, int x, int y) { return &r.rgb[3 * (size_t(y) * size_t(r.width) + size_t(x))]; }
 uint8_t pixel_class(const RelitImage &r, int x, int y) { return r.pixel_class[size_t(y) * size_t(r.width) + size_t(x)]; }
 
-TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
-  REQUIRE_GL(ctx);
-  const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
-  const float rho[3] = {0.5f, 0.3f, 0.1f};
-  const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
-  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
-  const Shot shot = top_camera();
-  float light[3] = {0.3f, 1.0f, 0.4f};
-  const float len = std::sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
-  for (float &c : light) c /= len;
-  const RelitImage r = renderer.render(shot, LightSource::directional({{light[0], light[1], light[2]}}));
-  ASSERT_EQ(r.width, kW);
-  ASSERT_EQ(r.height, kH);
-  EXPECT_EQ(count_class(r, kRelitShadowed), 0u);
-  EXPECT_EQ(count_class(r, kRelitNoFit), 0u);
-  size_t checked = 0;
-  double worst = 0;
-  for (int y = 2; y < kH - 2; y += 3)
-    for (int x = 2; x < kW - 2; x += 3) {
-      if (pixel_class(r, x, y) != kRelitLit) continue;
-      const vcg::Point3f p = plane_point(shot, x, y), e = (shot.GetViewPoint() - p).Normalize();
-      const vcg::Point3f n(0, 1, 0), l(light[0], light[1], light[2]);
-      const float d = n * l;
-      const vcg::Point3f refl = n * (2 * d) - l;
-      float expected[3];
-      evaluate_phong(fits[0], d, refl * e, expected);
-      for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::fabs(pixel(r, x, y)[c] - expected[c])));
-      ++checked;
-    }
-  EXPECT_GT(checked, 500u);  // the plane fills the view
-  EXPECT_LT(worst, 2e-3);
-}
-
-// A point light close over the plane: per pixel its own direction and the inverse-square fall-off
-// (light_source.h), the same numbers as the CPU's light_direction_at / light_irradiance_at.
-TEST(RelightRender, PointLightHasPerPixelDirectionAndFallOff) {
-  REQUIRE_GL(ctx);
-  const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
-  const float rho[3] = {0.5f, 0.3f, 0.1f};
-  const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
-  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
-  const Shot shot = top_camera();
-  LightSource light;
-  light.positional = true;
-  light.position = {{0.6f, 3.2f, -0.3f}};  // 3.2 above a plate of half-width 2: directions vary by ~60 degrees
-  light.reference_distance = 3.2f;
-  light.intensity = 0.8f;
-  const RelitImage r = renderer.render(shot, light);
-  size_t checked = 0;
+// Renders the lit plane y = 0 (uniform Phong fit) from top_camera() under `light` and compares
+// every third pixel with the model evaluated at the pixel's plane point: the light's direction and
+// irradiance there (light_source.h, as the CPU computes them).
+struct PlaneCheck {
+  size_t checked = 0, shadowed = 0, unfitted = 0;
   double worst = 0, brightest = 0, darkest = 1e9;
+};
+PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light) {
+  const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
+  const float rho[3] = {0.5f, 0.3f, 0.1f};
+  const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
+  RelightRenderer renderer(mesh.view(), fits, ctx.get_proc_address());
+  const Shot shot = top_camera();
+  const RelitImage r = renderer.render(shot, light);
+  EXPECT_EQ(r.width, kW);
+  EXPECT_EQ(r.height, kH);
+  PlaneCheck c;
+  c.shadowed = count_class(r, kRelitShadowed);
+  c.unfitted = count_class(r, kRelitNoFit);
   for (int y = 2; y < kH - 2; y += 3)
     for (int x = 2; x < kW - 2; x += 3) {
       if (pixel_class(r, x, y) != kRelitLit) continue;
@@ -129,16 +100,36 @@ TEST(RelightRender, PointLightHasPerPixelDirectionAndFallOff) {
       float expected[3];
       evaluate_phong(fits[0], d, refl * e, expected);
       const float irradiance = light_irradiance_at(light, pf);
-      for (int c = 0; c < 3; ++c) {
-        expected[c] *= irradiance;
-        worst = std::max(worst, double(std::fabs(pixel(r, x, y)[c] - expected[c])));
-      }
-      brightest = std::max(brightest, double(pixel(r, x, y)[0])), darkest = std::min(darkest, double(pixel(r, x, y)[0]));
-      ++checked;
+      for (int k = 0; k < 3; ++k)
+        c.worst = std::max(c.worst, double(std::fabs(pixel(r, x, y)[k] - expected[k] * irradiance)));
+      c.brightest = std::max(c.brightest, double(pixel(r, x, y)[0]));
+      c.darkest = std::min(c.darkest, double(pixel(r, x, y)[0]));
+      ++c.checked;
     }
-  EXPECT_GT(checked, 500u);
-  EXPECT_LT(worst, 3e-3);
-  EXPECT_GT(brightest, 1.5 * darkest);  // the fall-off and the changing N.L are really there
+  return c;
+}
+
+TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
+  REQUIRE_GL(ctx);
+  const PlaneCheck c = render_plane(*ctx, LightSource::directional({{0.3f, 1.0f, 0.4f}}));
+  EXPECT_EQ(c.shadowed, 0u);
+  EXPECT_EQ(c.unfitted, 0u);
+  EXPECT_GT(c.checked, 500u);  // the plane fills the view
+  EXPECT_LT(c.worst, 2e-3);
+}
+
+// A point light close over the plane: per pixel its own direction and the inverse-square fall-off.
+TEST(RelightRender, PointLightHasPerPixelDirectionAndFallOff) {
+  REQUIRE_GL(ctx);
+  LightSource light;
+  light.positional = true;
+  light.position = {{0.6f, 3.2f, -0.3f}};  // 3.2 above a plate of half-width 2: directions vary by ~60 degrees
+  light.reference_distance = 3.2f;
+  light.intensity = 0.8f;
+  const PlaneCheck c = render_plane(*ctx, light);
+  EXPECT_GT(c.checked, 500u);
+  EXPECT_LT(c.worst, 3e-3);
+  EXPECT_GT(c.brightest, 1.5 * c.darkest);  // the fall-off and the changing N.L are really there
   // The fall-off itself: inverse square of the distance, 1 x intensity at the reference distance.
   const float at_ref[3] = {0.6f, 0.0f, -0.3f}, twice[3] = {0.6f, -3.2f, -0.3f};
   EXPECT_NEAR(light_irradiance_at(light, at_ref), 0.8f, 1e-6f);
@@ -232,15 +223,15 @@ TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
   EXPECT_GT(c.psnr_db, 60.0);
   EXPECT_TRUE(good.files.empty());  // no folder: nothing written
   ASSERT_FALSE(good.color_log.empty());  // no chart in this photo: compared as decoded, and said so
-  EXPECT_NE(good.color_log.back().find("no usable chart"), std::string::npos) << good.color_log.back();
+  EXPECT_NE(good.color_log.back().find("colours uncorrected"), std::string::npos) << good.color_log.back();
   RelightOutputOptions required;
-  required.color_correction = RelightColorCorrection::Required;
+  required.color_correction = ColorCorrectionChoice::Required;
   EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, required), InputError);
   RelightOutputOptions corners;
   corners.chart_corners = {1, 2, 3};
   EXPECT_THROW(relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, corners), InputError);
   RelightOutputOptions off;
-  off.color_correction = RelightColorCorrection::Off;
+  off.color_correction = ColorCorrectionChoice::Off;
   EXPECT_TRUE(relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, off).color_log.empty());
   // Silhouette pixels are never compared: fewer pixels than the plane covers.
   const RelitImage r = renderer.render(scene.raster.shot, LightSource::directional(scene.light));
