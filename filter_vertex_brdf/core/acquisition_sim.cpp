@@ -1,4 +1,5 @@
 #include "acquisition_sim.h"
+#include "vec3.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,8 +12,6 @@
 namespace vbrdf {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 inline void set_bit(std::vector<uint64_t> &bits, size_t word0, size_t v) {
   bits[word0 + v / 64] |= uint64_t(1) << (v % 64);

@@ -22,13 +22,8 @@
 namespace vbrdf {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 
-std::string percent(size_t part, size_t whole) {
-  return whole ? fixed(100.0 * double(part) / double(whole), 1) + "%" : "0%";
-}
 
 std::string vec3(const float v[3], int digits = 4) {
   return fixed(v[0], digits) + " " + fixed(v[1], digits) + " " + fixed(v[2], digits);

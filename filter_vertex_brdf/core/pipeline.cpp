@@ -20,13 +20,8 @@
 namespace vbrdf {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 
-std::string percent(uint64_t part, uint64_t whole) {
-  return whole ? fixed(100.0 * double(part) / double(whole), 1) + "%" : "0%";
-}
 
 std::string report_path_for(const std::string &ply) { return strip_extension(ply) + "_report.txt"; }
 

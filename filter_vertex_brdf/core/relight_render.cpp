@@ -17,6 +17,7 @@
 #include "errors.h"
 #include "file_util.h"
 #include "gl_api.h"
+#include "gl_depth.h"
 #include "light_view.h"
 #include "output_ply.h"  // write_text_file_atomically
 #include "viewpoints.h"
@@ -116,32 +117,7 @@ void main() {
 }
 )";
 
-const char *const kShadowFragmentShader = R"(#version 330 core
-in float v_depth;
-layout(location = 0) out float o_depth;
-void main() { o_depth = v_depth; }
-)";
-
-const char *const kShadowVertexShader = R"(#version 330 core
-layout(location = 0) in vec3 a_position;
-uniform mat4 u_view;
-uniform mat4 u_projection;
-out float v_depth;
-void main() {
-  vec4 view_pos = u_view * vec4(a_position, 1.0);
-  v_depth = -view_pos.z;
-  gl_Position = u_projection * view_pos;
-}
-)";
-
 constexpr int kFloatsPerVertex = 12;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1
-
-// Column-major 4x4 matrix, as GL takes it.
-struct Mat4 {
-  float m[16] = {0};
-  float &at(int row, int col) { return m[col * 4 + row]; }
-  float at(int row, int col) const { return m[col * 4 + row]; }
-};
 
 struct Target {
   GLuint fbo = 0, color = 0, extra = 0, depth = 0;  // extra: the camera pass's depth output
@@ -201,30 +177,22 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   if (fits.size() != mesh.vertex_count)
     throw InputError("Relighting: " + std::to_string(fits.size()) + " per-vertex fits for a mesh of " +
                      std::to_string(mesh.vertex_count) + " vertices: use the fit of this mesh.");
-  if (mesh.index_count > size_t(INT_MAX))
-    throw ProcessingError("Relighting: the mesh has too many triangles for one OpenGL draw call.");
-  for (size_t i = 0; i < mesh.index_count; ++i)
-    if (mesh.indices[i] >= mesh.vertex_count)  // an out-of-range index can crash the GL driver
-      throw InputError("Relighting: face " + std::to_string(i / 3) + " references vertex " +
-                       std::to_string(mesh.indices[i]) + " which does not exist.");
+  const GlMeshFrame frame = gl_mesh_frame(mesh, settings.depth_tolerance, "Relighting");
+  std::copy(frame.origin, frame.origin + 3, origin_);
+  std::copy(&frame.corners[0][0], &frame.corners[0][0] + 24, &corners_[0][0]);
+  radius_ = frame.radius;
+  tolerance_ = frame.tolerance;
   VisibilitySettings visibility;
   visibility.depth_tolerance = settings.depth_tolerance;
   visibility.shadow_map_size = settings.shadow_map_size;
   settings_.shadow_map_size = resolved_shadow_map_size(mesh, visibility);
   renderer = gl_.version_string();
-  const Bounds b = compute_bounds(mesh);
-  tolerance_ = settings.depth_tolerance * b.diagonal();
-  if (mesh.vertex_count > 0) {
-    for (int k = 0; k < 3; ++k) origin_[k] = 0.5f * (b.min[k] + b.max[k]);
-    for (int c = 0; c < 8; ++c)
-      for (int k = 0; k < 3; ++k) corners_[c][k] = ((c >> k) & 1 ? b.max[k] : b.min[k]) - origin_[k];
-  }
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
   try {
     check_size(settings_.shadow_map_size, settings_.shadow_map_size, "the shadow map");
     shade_program_ = build_program(gl_, kShadeVertexShader, kShadeFragmentShader, "the relighting pass");
-    shadow_program_ = build_program(gl_, kShadowVertexShader, kShadowFragmentShader, "the relighting shadow map");
+    shadow_program_ = build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map");
     upload(mesh, fits);
     check_gl_error(gl_, "the upload of the mesh for relighting");
   } catch (...) {
@@ -236,7 +204,6 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
 void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
   const float alpha_default = typical_shininess(fits);
   std::vector<float> data(mesh.vertex_count * kFloatsPerVertex);
-  float r2 = 0;
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
     float *o = &data[v * kFloatsPerVertex];
     const VertexFit &f = fits[v];
@@ -245,12 +212,10 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
       o[3 + k] = mesh.normals[3 * v + k];
       o[6 + k] = f.kd * f.color[k];
     }
-    r2 = std::max(r2, o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
     o[9] = f.status == kFitNone ? 0.0f : 1.0f;
     o[10] = f.ks;
     o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
   }
-  radius_ = std::sqrt(r2);
   index_count_ = mesh.index_count;
 
   gl_.GenVertexArrays(1, &vao_);
@@ -272,16 +237,7 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
 }
 
 void RelightRenderer::Impl::check_size(int width, int height, const std::string &what) const {
-  GLint max_texture = 0, max_renderbuffer = 0, max_viewport[2] = {0, 0};
-  gl_.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
-  gl_.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
-  gl_.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
-  const int limit_x = std::min(std::min(max_texture, max_renderbuffer), max_viewport[0]);
-  const int limit_y = std::min(std::min(max_texture, max_renderbuffer), max_viewport[1]);
-  if (width > limit_x || height > limit_y)
-    throw ProcessingError("Relighting: " + what + " needs a " + std::to_string(width) + "x" + std::to_string(height) +
-                          " render target, but this OpenGL (" + gl_.version_string() + ") allows at most " +
-                          std::to_string(limit_x) + "x" + std::to_string(limit_y) + ".");
+  check_gl_target_size(gl_, width, height, "Relighting", what);
 }
 
 void RelightRenderer::Impl::ensure_target(Target &t, int width, int height, bool camera, const std::string &what) {

@@ -1,7 +1,9 @@
 #pragma once
-// The small 3-vector vocabulary of the core, on plain arrays (the layout MeshView and the GL
-// buffers use): one definition instead of a copy per file. Where a file works with vcglib's
+// The small vocabulary of the core: 3-vectors on plain arrays (the layout MeshView and the GL
+// buffers use), pi, and the number formats and timer of the reports; one definition instead of a
+// copy per file. Where a file works with vcglib's
 // Point3 (camera, visibility_cpu) it uses vcglib's operators instead.
+#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -32,6 +34,9 @@ inline T normalize3(T *v) {
   return n;
 }
 
+// "12.3%" for percent(123, 1000): shares in reports ("0%" when `whole` is 0).
+inline std::string percent(double part, double whole);
+
 // "1.23" for fixed(1.234, 2): the number format of the reports and logs.
 inline std::string fixed(double v, int digits = 2) {
   std::ostringstream s;
@@ -39,6 +44,16 @@ inline std::string fixed(double v, int digits = 2) {
   s.precision(digits);
   s << v;
   return s.str();
+}
+
+inline std::string percent(double part, double whole) {
+  return whole > 0 ? fixed(100.0 * part / whole, 1) + "%" : "0%";
+}
+
+// Seconds since `start` on the steady clock: the stage timings of the reports.
+using Clock = std::chrono::steady_clock;
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 } // namespace vbrdf

@@ -12,41 +12,15 @@
 
 #include "errors.h"
 #include "gl_api.h"
+#include "gl_depth.h"
 #include "light_view.h"
 
 namespace vbrdf {
 
 namespace {
 
-// Linear depth along the viewing axis (positive in front of a camera), exact per fragment since
-// varyings are interpolated perspective-correctly.
-const char *const kDepthVertexShader = R"(#version 330 core
-layout(location = 0) in vec3 a_position;
-uniform mat4 u_view;
-uniform mat4 u_projection;
-out float v_depth;
-void main() {
-  vec4 view_pos = u_view * vec4(a_position, 1.0);
-  v_depth = -view_pos.z;
-  gl_Position = u_projection * view_pos;
-}
-)";
-
-const char *const kDepthFragmentShader = R"(#version 330 core
-in float v_depth;
-layout(location = 0) out float o_depth;
-void main() { o_depth = v_depth; }
-)";
-
 // Background value: farther than anything, so vertices next to the mesh silhouette stay clear.
 const float kFarAway = FLT_MAX;
-
-// Column-major 4x4 matrix, as GL takes it.
-struct Mat4 {
-  float m[16] = {0};
-  float &at(int row, int col) { return m[col * 4 + row]; }
-  float at(int row, int col) const { return m[col * 4 + row]; }
-};
 
 void transform(const Mat4 &a, const float p[3], float out[4]) {
   for (int row = 0; row < 4; ++row)
@@ -118,28 +92,18 @@ private:
 
 GlVisibility::GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_proc, const VisibilitySettings &settings)
     : mesh_(mesh), settings_(settings), gl_(load_gl_api(get_proc)) {
-  if (mesh.index_count > size_t(INT_MAX))
-    throw ProcessingError("OpenGL visibility: the mesh has " + std::to_string(mesh.index_count / 3) +
-                          " triangles, more than one OpenGL draw call can take.");
-  for (size_t i = 0; i < mesh.index_count; ++i)
-    if (mesh.indices[i] >= mesh.vertex_count)  // an out-of-range index can crash the GL driver
-      throw InputError("OpenGL visibility: face " + std::to_string(i / 3) + " references vertex " +
-                       std::to_string(mesh.indices[i]) + " which does not exist.");
+  const GlMeshFrame frame = gl_mesh_frame(mesh, settings.depth_tolerance, "OpenGL visibility");
+  std::copy(frame.origin, frame.origin + 3, origin_);
+  std::copy(&frame.corners[0][0], &frame.corners[0][0] + 24, &corners_[0][0]);
+  radius_ = frame.radius;
+  tolerance_ = frame.tolerance;
   settings_.shadow_map_size = resolved_shadow_map_size(mesh, settings);
   check_target_size(settings_.shadow_map_size, settings_.shadow_map_size, "the light-view shadow map");
-
-  const Bounds b = compute_bounds(mesh);
-  tolerance_ = settings.depth_tolerance * b.diagonal();
-  if (mesh.vertex_count > 0) {
-    for (int k = 0; k < 3; ++k) origin_[k] = 0.5f * (b.min[k] + b.max[k]);
-    for (int c = 0; c < 8; ++c)
-      for (int k = 0; k < 3; ++k) corners_[c][k] = ((c >> k) & 1 ? b.max[k] : b.min[k]) - origin_[k];
-  }
 
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);  // errors left by the host are not ours
   try {
-    program_ = build_program(gl_, kDepthVertexShader, kDepthFragmentShader, "the visibility depth pass");
+    program_ = build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the visibility depth pass");
     u_view_ = gl_.GetUniformLocation(program_, "u_view");
     u_projection_ = gl_.GetUniformLocation(program_, "u_projection");
     upload_mesh();
@@ -163,17 +127,7 @@ void GlVisibility::release_gl() {
 }
 
 void GlVisibility::check_target_size(int width, int height, const std::string &what) const {
-  GLint max_texture = 0, max_renderbuffer = 0, max_viewport[2] = {0, 0};
-  gl_.GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
-  gl_.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
-  gl_.GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
-  const int limit_x = std::min(std::min(max_texture, max_renderbuffer), max_viewport[0]);
-  const int limit_y = std::min(std::min(max_texture, max_renderbuffer), max_viewport[1]);
-  if (width > limit_x || height > limit_y)
-    throw ProcessingError("OpenGL visibility: " + what + " needs a " + std::to_string(width) + "x" +
-                          std::to_string(height) + " render target, but this OpenGL (" + gl_.version_string() +
-                          ") allows at most " + std::to_string(limit_x) + "x" + std::to_string(limit_y) +
-                          ". Use smaller photos / shadow map, or the CPU visibility.");
+  check_gl_target_size(gl_, width, height, "OpenGL visibility", what);
 }
 
 void GlVisibility::upload_mesh() {
@@ -182,12 +136,6 @@ void GlVisibility::upload_mesh() {
   std::vector<float> local(mesh_.vertex_count * 3);
   for (size_t v = 0; v < mesh_.vertex_count; ++v)
     for (int k = 0; k < 3; ++k) local[3 * v + k] = mesh_.positions[3 * v + k] - origin_[k];
-  float r2 = 0;
-  for (size_t v = 0; v < mesh_.vertex_count; ++v) {
-    const float *p = &local[3 * v];
-    r2 = std::max(r2, p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-  }
-  radius_ = std::sqrt(r2);
 
   gl_.GenVertexArrays(1, &vao_);
   gl_.BindVertexArray(vao_);
