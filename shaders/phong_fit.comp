@@ -1,6 +1,6 @@
 #version 430
-// Per-vertex Phong fit, one invocation per vertex, float32. Contract: core/phong_fit.h; this is a
-// transcription of the double-precision reference core/phong_fit_cpu.cpp (keep them in step).
+// Per-vertex Phong fit, one invocation per vertex, float32. Contract: core/fit/phong_fit.h; this is a
+// transcription of the double-precision reference core/fit/phong_fit_cpu.cpp (keep them in step).
 // There are no per-vertex arrays in GLSL, so every stage loops over the vertex's sample range again
 // ("passes"); a dropped highlight sample is skipped by every loop.
 //
@@ -17,17 +17,17 @@
 // is not usable; the alpha_from_highlights fallback is the clamped alpha_init; the convergence
 // floor is relative to the data's scale, so very small pixel values are fitted like ordinary ones.
 // The fallback fit for vertices without a strictly usable sample (fit_vertex_weak, fit_status 4)
-// and the neighbour fill (fit_status 3) run on the CPU after either back end (core/pipeline.cpp).
+// and the neighbour fill (fit_status 3) run on the CPU after either back end (core/fit/pipeline.cpp).
 layout(local_size_x = 64) in;
 
-struct Sample {  // core/samples.h Sample, 24 bytes
+struct Sample {  // core/samples/samples.h Sample, 24 bytes
   float r, g, b;
   float d;             // N.L
   float s;             // R.E
   uint raster_flags;   // raster | flags << 16
 };
 
-struct Fit {  // core/phong_fit.h VertexFit, 40 bytes
+struct Fit {  // core/fit/phong_fit.h VertexFit, 40 bytes
   float color[3];
   float kd, ks, shininess, dq, sq, rmse;
   uint bits;  // iterations | status << 16 | converged << 24

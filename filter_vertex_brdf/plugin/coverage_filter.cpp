@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "core/errors.h"
+#include "core/base/errors.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"
 

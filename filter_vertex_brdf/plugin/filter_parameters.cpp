@@ -5,7 +5,7 @@
 #include <QDir>
 #include <QFileInfo>
 
-#include "core/errors.h"
+#include "core/base/errors.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {

@@ -23,12 +23,12 @@
 
 #include <common/interfaces.h>
 
-#include "core/color_chart.h"
-#include "core/photo.h"
-#include "core/pipeline.h"
-#include "core/samples.h"
-#include "core/sphere_lights.h"
-#include "core/visibility.h"
+#include "core/calibration/color_chart.h"
+#include "core/inputs/photo.h"
+#include "core/fit/pipeline.h"
+#include "core/samples/samples.h"
+#include "core/calibration/sphere_lights.h"
+#include "core/visibility/visibility.h"
 
 namespace vbrdf_plugin {
 

@@ -3,7 +3,7 @@
 #include <exception>
 #include <string>
 
-#include "core/errors.h"
+#include "core/base/errors.h"
 #include "coverage_filter.h"
 #include "fit_filter.h"
 #include "import_photos_filter.h"

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "core/errors.h"
-#include "core/result_schema.h"
+#include "core/base/errors.h"
+#include "core/io/result_schema.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"
 

@@ -7,10 +7,10 @@
 #include <QFileInfo>
 #include <QImageReader>
 
-#include "core/coverage_run.h"
-#include "core/errors.h"
-#include "core/file_util.h"
-#include "core/light_file.h"
+#include "core/coverage/coverage_run.h"
+#include "core/base/errors.h"
+#include "core/base/file_util.h"
+#include "core/inputs/light_file.h"
 #include "coverage_filter.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"

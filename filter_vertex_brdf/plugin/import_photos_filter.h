@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/sphere_lights.h"
+#include "core/calibration/sphere_lights.h"
 #include "plugin_filter.h"
 
 namespace vbrdf_plugin {

@@ -10,7 +10,7 @@
 
 #include <vcg/complex/allocate.h>
 
-#include "core/errors.h"
+#include "core/base/errors.h"
 
 namespace vbrdf_plugin {
 

@@ -6,10 +6,10 @@
 
 #include <common/interfaces.h>
 
-#include "core/camera.h"
-#include "core/mesh_view.h"
-#include "core/output_ply.h"
-#include "core/samples.h"
+#include "core/inputs/camera.h"
+#include "core/base/mesh_view.h"
+#include "core/io/output_ply.h"
+#include "core/samples/samples.h"
 
 namespace vbrdf_plugin {
 

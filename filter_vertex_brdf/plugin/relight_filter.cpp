@@ -7,16 +7,16 @@
 #include <QFileInfo>
 #include <vcg/complex/allocate.h>
 
-#include "core/errors.h"
-#include "core/file_util.h"
-#include "core/light_file.h"
-#include "core/light_source.h"
-#include "core/output_ply.h"
-#include "core/pipeline.h"
-#include "core/project.h"
-#include "core/relight_render.h"
-#include "core/result_ply.h"
-#include "core/result_schema.h"
+#include "core/base/errors.h"
+#include "core/base/file_util.h"
+#include "core/inputs/light_file.h"
+#include "core/inputs/light_source.h"
+#include "core/io/output_ply.h"
+#include "core/fit/pipeline.h"
+#include "core/inputs/project.h"
+#include "core/relight/relight_render.h"
+#include "core/io/result_ply.h"
+#include "core/io/result_schema.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"
 

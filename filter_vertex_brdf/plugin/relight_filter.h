@@ -5,9 +5,9 @@
 // viewpoint under a light the user gives. The mesh is not changed.
 #include <string>
 
-#include "core/orbit_camera.h"
-#include "core/relight_render.h"
-#include "core/relight_report.h"
+#include "core/relight/orbit_camera.h"
+#include "core/relight/relight_render.h"
+#include "core/relight/relight_report.h"
 #include "plugin_filter.h"
 
 namespace vbrdf_plugin {

@@ -10,14 +10,14 @@
 #include <QDir>
 #include <QFileInfo>
 
-#include "core/camera.h"
-#include "core/errors.h"
-#include "core/file_util.h"
-#include "core/light_file.h"
-#include "core/light_source.h"
-#include "core/photo.h"
-#include "core/pipeline.h"
-#include "core/sphere_lights.h"
+#include "core/inputs/camera.h"
+#include "core/base/errors.h"
+#include "core/base/file_util.h"
+#include "core/inputs/light_file.h"
+#include "core/inputs/light_source.h"
+#include "core/inputs/photo.h"
+#include "core/fit/pipeline.h"
+#include "core/calibration/sphere_lights.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "core/photo.h"
-#include "core/sphere_lights.h"
+#include "core/inputs/photo.h"
+#include "core/calibration/sphere_lights.h"
 #include "plugin_filter.h"
 
 namespace vbrdf_plugin {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "coverage.h"
+#include "coverage/coverage.h"
 #include "test_scenes.h"
 
 using namespace vbrdf;

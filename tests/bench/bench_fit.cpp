@@ -24,10 +24,10 @@
 #include <string>
 #include <vector>
 
-#include "errors.h"
+#include "base/errors.h"
 #include "osmesa_context.h"
-#include "phong_fit.h"
-#include "phong_fit_gpu.h"
+#include "fit/phong_fit.h"
+#include "fit/phong_fit_gpu.h"
 
 using namespace vbrdf;
 

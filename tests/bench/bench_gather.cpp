@@ -15,13 +15,13 @@
 #include <string>
 #include <vector>
 
-#include "diffuse_color.h"
-#include "light_file.h"
-#include "mesh_io.h"
+#include "samples/diffuse_color.h"
+#include "inputs/light_file.h"
+#include "tools/mesh_io.h"
 #include "osmesa_context.h"
-#include "pipeline.h"
-#include "project.h"
-#include "visibility_gl.h"
+#include "fit/pipeline.h"
+#include "inputs/project.h"
+#include "visibility/visibility_gl.h"
 
 using namespace vbrdf;
 

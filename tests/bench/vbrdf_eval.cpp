@@ -40,16 +40,16 @@
 #include <memory>
 #include <string>
 
-#include "errors.h"
-#include "file_util.h"
-#include "light_file.h"
+#include "base/errors.h"
+#include "base/file_util.h"
+#include "inputs/light_file.h"
 #include "osmesa_context.h"
-#include "pipeline.h"
-#include "project.h"
-#include "relight.h"
-#include "relight_render.h"
-#include "result_ply.h"
-#include "visibility_gl.h"
+#include "fit/pipeline.h"
+#include "inputs/project.h"
+#include "tools/relight.h"
+#include "relight/relight_render.h"
+#include "io/result_ply.h"
+#include "visibility/visibility_gl.h"
 
 using namespace vbrdf;
 

@@ -13,12 +13,12 @@
 #include <memory>
 #include <string>
 
-#include "errors.h"
-#include "file_util.h"
-#include "mesh_io.h"
+#include "base/errors.h"
+#include "base/file_util.h"
+#include "tools/mesh_io.h"
 #include "osmesa_context.h"
-#include "pipeline.h"
-#include "project.h"
+#include "fit/pipeline.h"
+#include "inputs/project.h"
 
 using namespace vbrdf;
 

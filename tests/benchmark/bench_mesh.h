@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "mesh_view.h"
+#include "base/mesh_view.h"
 
 namespace vbrdf {
 namespace bench {

@@ -8,10 +8,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib_data.h"
-#include "color_chart.h"
-#include "color_difference.h"
-#include "errors.h"
-#include "light_file.h"
+#include "calibration/color_chart.h"
+#include "base/color_difference.h"
+#include "base/errors.h"
+#include "inputs/light_file.h"
 
 namespace vbrdf {
 namespace calib {

@@ -8,9 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "errors.h"
-#include "light_file.h"
-#include "project.h"
+#include "base/errors.h"
+#include "inputs/light_file.h"
+#include "inputs/project.h"
 
 namespace vbrdf {
 namespace calib {

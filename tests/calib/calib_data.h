@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "sphere_lights.h"
+#include "calibration/sphere_lights.h"
 
 namespace vbrdf {
 namespace calib {

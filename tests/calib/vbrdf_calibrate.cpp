@@ -26,10 +26,10 @@
 
 #include "calib_data.h"
 #include "calib_chart.h"
-#include "errors.h"
-#include "light_file.h"
-#include "project.h"
-#include "sphere_lights.h"
+#include "base/errors.h"
+#include "inputs/light_file.h"
+#include "inputs/project.h"
+#include "calibration/sphere_lights.h"
 #include "test_paths.h"
 
 using namespace vbrdf;

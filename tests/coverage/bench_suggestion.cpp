@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "coverage_run.h"
+#include "coverage/coverage_run.h"
 #include "test_scenes.h"
 
 using namespace vbrdf;

@@ -12,13 +12,13 @@
 #include <memory>
 #include <string>
 
-#include "coverage_run.h"
-#include "errors.h"
-#include "mesh_io.h"
+#include "coverage/coverage_run.h"
+#include "base/errors.h"
+#include "tools/mesh_io.h"
 #include "osmesa_context.h"
-#include "output_ply.h"
-#include "project.h"
-#include "result_ply.h"
+#include "io/output_ply.h"
+#include "inputs/project.h"
+#include "io/result_ply.h"
 
 using namespace vbrdf;
 

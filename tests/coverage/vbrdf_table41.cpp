@@ -21,12 +21,12 @@
 #include <string>
 #include <vector>
 
-#include "acquisition_sim.h"
-#include "coverage_run.h"
-#include "errors.h"
-#include "mesh_io.h"
+#include "tools/acquisition_sim.h"
+#include "coverage/coverage_run.h"
+#include "base/errors.h"
+#include "tools/mesh_io.h"
 #include "osmesa_context.h"
-#include "project.h"
+#include "inputs/project.h"
 
 using namespace vbrdf;
 

@@ -10,7 +10,7 @@
 #include <QDomDocument>
 #include <gtest/gtest.h>
 
-#include "core/errors.h"
+#include "core/base/errors.h"
 #include "coverage_filter.h"
 #include "filter_parameters.h"
 #include "fit_filter.h"

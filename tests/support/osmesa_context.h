@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "visibility_gl.h"  // vbrdf::GetProcAddressFn
+#include "visibility/visibility_gl.h"  // vbrdf::GetProcAddressFn
 
 struct osmesa_context;  // OSMesaContext is `struct osmesa_context *`
 

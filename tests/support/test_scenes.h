@@ -1,7 +1,7 @@
 #pragma once
 // Small scenes built in code for unit tests: shots and meshes.
-#include "camera.h"
-#include "mesh_view.h"
+#include "inputs/camera.h"
+#include "base/mesh_view.h"
 
 namespace vbrdf {
 namespace test {

@@ -4,7 +4,7 @@
 #include <random>
 #include <vector>
 
-#include "phong_fit.h"
+#include "fit/phong_fit.h"
 
 namespace vbrdf {
 namespace test {

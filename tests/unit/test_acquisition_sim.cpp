@@ -4,11 +4,11 @@
 #include <cmath>
 #include <gtest/gtest.h>
 
-#include "acquisition_sim.h"
-#include "coverage_run.h"
-#include "errors.h"
-#include "mesh_io.h"
-#include "project.h"
+#include "tools/acquisition_sim.h"
+#include "coverage/coverage_run.h"
+#include "base/errors.h"
+#include "tools/mesh_io.h"
+#include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

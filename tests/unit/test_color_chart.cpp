@@ -12,10 +12,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib_data.h"
-#include "color_chart.h"
-#include "color_difference.h"
-#include "errors.h"
-#include "photo.h"
+#include "calibration/color_chart.h"
+#include "base/color_difference.h"
+#include "base/errors.h"
+#include "inputs/photo.h"
 #include "test_paths.h"
 
 using namespace vbrdf;

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 #include <random>
 
-#include "coverage.h"
+#include "coverage/coverage.h"
 #include "test_scenes.h"
 
 using namespace vbrdf;

@@ -8,12 +8,12 @@
 #include <random>
 #include <unistd.h>
 
-#include "coverage_run.h"
-#include "errors.h"
-#include "light_file.h"
-#include "mesh_io.h"
-#include "pipeline.h"
-#include "project.h"
+#include "coverage/coverage_run.h"
+#include "base/errors.h"
+#include "inputs/light_file.h"
+#include "tools/mesh_io.h"
+#include "fit/pipeline.h"
+#include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 #include <random>
 
-#include "diffuse_color.h"
+#include "samples/diffuse_color.h"
 
 using namespace vbrdf;
 

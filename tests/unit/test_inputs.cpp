@@ -2,12 +2,12 @@
 #include <fstream>
 #include <gtest/gtest.h>
 
-#include "camera.h"
-#include "errors.h"
-#include "file_util.h"
-#include "light_file.h"
-#include "pipeline.h"
-#include "project.h"
+#include "inputs/camera.h"
+#include "base/errors.h"
+#include "base/file_util.h"
+#include "inputs/light_file.h"
+#include "fit/pipeline.h"
+#include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

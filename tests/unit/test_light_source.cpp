@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "errors.h"
-#include "light_source.h"
-#include "samples.h"
+#include "base/errors.h"
+#include "inputs/light_source.h"
+#include "samples/samples.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

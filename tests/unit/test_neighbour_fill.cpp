@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "neighbour_fill.h"
-#include "phong_fit.h"
+#include "fit/neighbour_fill.h"
+#include "fit/phong_fit.h"
 #include "test_scenes.h"
 
 namespace vbrdf {

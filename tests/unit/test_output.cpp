@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 #include <sstream>
 
-#include "errors.h"
-#include "file_util.h"
-#include "output_ply.h"
+#include "base/errors.h"
+#include "base/file_util.h"
+#include "io/output_ply.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "errors.h"
-#include "gl_api.h"
+#include "base/errors.h"
+#include "gl/gl_api.h"
 #include "osmesa_context.h"
-#include "phong_fit.h"
-#include "phong_fit_gpu.h"
+#include "fit/phong_fit.h"
+#include "fit/phong_fit_gpu.h"
 #include "phong_test_util.h"
 
 namespace vbrdf {

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 #include <random>
 
-#include "phong_fit.h"
+#include "fit/phong_fit.h"
 #include "phong_test_util.h"
 
 using namespace vbrdf;

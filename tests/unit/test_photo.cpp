@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "errors.h"
-#include "photo.h"
+#include "base/errors.h"
+#include "inputs/photo.h"
 #include "test_paths.h"
 
 using namespace vbrdf;

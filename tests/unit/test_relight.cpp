@@ -3,13 +3,13 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "errors.h"
-#include "output_ply.h"
-#include "relight.h"
-#include "result_ply.h"
+#include "base/errors.h"
+#include "io/output_ply.h"
+#include "tools/relight.h"
+#include "io/result_ply.h"
 #include "test_paths.h"
 #include "test_scenes.h"
-#include "visibility.h"
+#include "visibility/visibility.h"
 
 using namespace vbrdf;
 

@@ -12,13 +12,13 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "color_difference.h"
-#include "errors.h"
-#include "file_util.h"
+#include "base/color_difference.h"
+#include "base/errors.h"
+#include "base/file_util.h"
 #include "osmesa_context.h"
-#include "orbit_camera.h"
-#include "relight_render.h"
-#include "relight_report.h"
+#include "relight/orbit_camera.h"
+#include "relight/relight_render.h"
+#include "relight/relight_report.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

@@ -7,10 +7,10 @@
 #include <set>
 #include <sstream>
 
-#include "errors.h"
-#include "output_ply.h"
-#include "result_ply.h"
-#include "result_schema.h"
+#include "base/errors.h"
+#include "io/output_ply.h"
+#include "io/result_ply.h"
+#include "io/result_schema.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 #include <vector>
 
-#include "rti_baselines.h"
+#include "tools/rti_baselines.h"
 
 using namespace vbrdf;
 

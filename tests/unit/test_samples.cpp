@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "samples.h"
+#include "samples/samples.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 

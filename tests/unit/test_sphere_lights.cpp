@@ -9,10 +9,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "calib_data.h"
-#include "errors.h"
-#include "light_file.h"
-#include "photo.h"
-#include "sphere_lights.h"
+#include "base/errors.h"
+#include "inputs/light_file.h"
+#include "inputs/photo.h"
+#include "calibration/sphere_lights.h"
 #include "test_paths.h"
 
 using namespace vbrdf;

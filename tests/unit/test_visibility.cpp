@@ -10,14 +10,14 @@
 #include <string>
 #include <vector>
 
-#include "camera.h"
+#include "inputs/camera.h"
 #include "test_scenes.h"
-#include "errors.h"
-#include "gl_api.h"
-#include "mesh_view.h"
+#include "base/errors.h"
+#include "gl/gl_api.h"
+#include "base/mesh_view.h"
 #include "osmesa_context.h"
-#include "visibility.h"
-#include "visibility_gl.h"
+#include "visibility/visibility.h"
+#include "visibility/visibility_gl.h"
 
 namespace vbrdf {
 namespace {

@@ -1,0 +1,214 @@
+#pragma once
+// Acquisition feedback without MeshLab (thesis 4.4.1, 4.5, 4.7): project -> lights -> visibility
+// -> samples -> per-vertex coverage counts and classes -> next diffuse and specular light for one
+// viewpoint -> colours, report and suggestion file. The coverage filter, the photo import filter
+// and the vbrdf_coverage tool all call run_coverage; they differ only in how they get the mesh,
+// the rasters and the GL context.
+//
+// Viewpoints: photos of one viewpoint share one registration, i.e. an identical shot. Rasters are
+// grouped by shot; suggestions are for one viewpoint (by default the one of the last raster, the
+// photographer's current camera position), since a light is only placeable relative to a camera.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "inputs/camera.h"
+#include "coverage/coverage.h"
+#include "inputs/light_file.h"
+#include "inputs/light_source.h"
+#include "base/mesh_view.h"
+#include "fit/pipeline.h"
+#include "samples/samples.h"
+#include "calibration/sphere_lights.h"
+#include "inputs/viewpoints.h"
+#include "visibility/visibility.h"
+
+namespace vbrdf {
+
+// Lenient light lookup for an acquisition in progress: every raster needs an entry in `lp_path`
+// (InputError naming the .lp and the raster otherwise); entries for photos not imported yet are
+// allowed (their names go to `unused` when given). Directions are returned in world coordinates.
+std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &rasters, const std::string &lp_path,
+                                                     std::vector<std::string> *unused = nullptr);
+
+struct CoverageSettings {
+  GatherSettings gather;            // T_s and T_d classify samples and drive the suggestions
+  VisibilitySettings visibility;
+  VisibilityChoice visibility_choice = VisibilityChoice::Auto;
+  LightSuggestionSettings suggest;  // its thresholds are replaced by gather's
+  int min_diffuse = 1;              // diffuse samples a vertex needs to count as diffusely covered
+  int min_specular = 1;             // specular samples it needs to count as specularly covered
+  int viewpoint_raster = -1;        // suggestions for the viewpoint of this raster; -1: the last raster
+  // With a fit (CoverageInput::dq/sq): a covered vertex whose DQ (SQ) is below this still needs
+  // diffuse (specular) samples, weighted (poor - q) / poor; uncovered vertices weigh 1.
+  float poor_dq = 1.5f;
+  float poor_sq = 1.5f;
+  float tolerance_deg = 0;          // suggestions robust to this light placement error (0: exact)
+  float failure_cone_deg = 20;      // suggest_light_learning: learn from failed predictions (0: off)
+  // Learn from the previous suggestion file (same path): when photos were added to the viewpoint
+  // since, its recommended light counts as followed, i.e. as a light whose promises are checked
+  // (suggest_light_learning), together with the lights followed before. Needs write_files.
+  bool learn_from_previous = true;
+  std::string light_file;           // "" = find_default_light_file (light_file.h); .json / .dome: light_source.h
+  float dome_radius = 0;            // as FitSettings: the .lp's directions as point lights on a dome
+  float light_unit_scale = 0;       // as FitSettings: mesh units per unit of the light file's positions
+  std::string suggestion_file;      // "" = <project folder>/<project name>_next_light.txt
+  bool write_files = true;          // false: nothing is written (result only)
+};
+
+struct CoverageInput {
+  MeshView mesh;
+  std::string mesh_name;            // for messages
+  std::vector<Raster> rasters;
+  std::string project_path;         // the .mlp (default paths; may be empty)
+  std::vector<float> dq, sq;        // optional per-vertex fit quality in [0, 2] (empty: no fit)
+  std::string quality_source;       // where dq/sq came from (report)
+};
+
+// Suggestions robust to where the photographer actually puts the light: the thresholds tightened
+// by `tolerance_deg` (diffuse: N.L >= cos(acos(T_d) - tol) and R.E <= cos(acos(T_s) + tol);
+// specular: R.E >= cos(acos(T_s) - tol)), so that a light placed up to that far from the
+// suggestion still covers what it promises. Falls back to the exact thresholds when no light is
+// robust. `covered_vertices` of the result counts with the exact thresholds; `robust_covered`
+// (optional) receives the count that holds within the tolerance (0 after a fallback).
+// `brute_force`: suggest_next_light_brute_force instead of the binned search (tests, Table 4.1).
+LightSuggestion suggest_light_with_tolerance(const MeshView &mesh, const Shot &viewpoint, const uint8_t *visible,
+                                             const float *needs, CoverageKind kind, const LightSuggestionSettings &s,
+                                             float tolerance_deg, size_t *robust_covered = nullptr,
+                                             bool brute_force = false);
+
+// The next light, learning from the photos taken so far: a vertex that still needs samples
+// although a photo's light near the suggestion (within `failure_cone_deg`) was predicted to give
+// it one (a cast shadow or a clipped pixel prevented it; the prediction cannot know) does not
+// count for that suggestion. Otherwise the vertex's ideal light (Algorithms 1/3) would bring the
+// same failed light back again and again. So: failed vertices whose own best direction (normal,
+// mirror direction) lies near a light that failed them are left out of the binned search; a
+// suggestion that still counts many failed vertices is recomputed without them (at most 4
+// rounds); if nothing is left, 600 directions over the placeable hemisphere are scored with the
+// failures taken into account. When every light predicted to help has failed, the plain
+// suggestion is returned and *repeats_failed (optional) is set. Without taken lights or failures
+// this is suggest_light_with_tolerance. `taken_lights`: world directions of the photos of this
+// viewpoint (and of suggestions that were followed). Needs and tolerance as above.
+LightSuggestion suggest_light_learning(const MeshView &mesh, const Shot &viewpoint, const uint8_t *visible,
+                                       const float *needs, CoverageKind kind, const LightSuggestionSettings &s,
+                                       float tolerance_deg, const std::vector<std::array<float, 3>> &taken_lights,
+                                       float failure_cone_deg = 20.0f, size_t *robust_covered = nullptr,
+                                       bool *repeats_failed = nullptr, bool brute_force = false);
+
+// Weight factor of a vertex that still needs samples although `failures` photos of its viewpoint
+// had a light predicted to give it such a sample (a cast shadow or a saturated pixel prevented
+// it; the prediction cannot know): 0.2^failures, so that the next suggestion moves on instead of
+// repeating a light whose shadow hides the vertex.
+float prediction_failure_weight(int failures);
+
+// Per-vertex weights of the vertices that need samples (0: needs none). See CoverageSettings.
+struct CoverageNeeds {
+  std::vector<float> diffuse, specular;
+  size_t poor_diffuse = 0, poor_specular = 0;  // covered vertices that need samples for a poor fit
+};
+
+// Needs from coverage counts and, when `dq`/`sq` are non-null, fit quality (see CoverageSettings).
+// Only vertices with at least one diffuse sample can need specular samples (the fit needs the
+// diffuse part first). `diffuse_failures`/`specular_failures` (optional, per vertex) scale the
+// weights of uncovered vertices by prediction_failure_weight.
+CoverageNeeds coverage_needs(const std::vector<CoverageCounts> &counts, const float *dq, const float *sq,
+                             const CoverageSettings &settings, const uint16_t *diffuse_failures = nullptr,
+                             const uint16_t *specular_failures = nullptr);
+
+// Per vertex, how many photos of `viewpoint` had a light that the suggestions' geometry
+// (light_covers_diffuse / light_covers_specular) says covers it while the vertex still lacks
+// that kind of sample (class kSeenNotDiffuse / kDiffuseNoSpecular); 0 elsewhere.
+void prediction_failures(const MeshView &mesh, const std::vector<uint8_t> &classes, const Viewpoint &viewpoint,
+                         const std::vector<LightSource> &lights, const LightSuggestionSettings &s,
+                         std::vector<uint16_t> &diffuse, std::vector<uint16_t> &specular);
+
+// Why a vertex can only be covered from a new viewpoint.
+enum NewViewReason : uint8_t {
+  kNewViewUnseen = 1,    // no photo sees it
+  kNewViewDiffuse = 2,   // needs diffuse samples; no placeable light of any viewpoint gives one
+  kNewViewSpecular = 4,  // needs specular samples; no placeable light of any viewpoint gives one
+};
+
+// Per vertex, the NewViewReason of a vertex only a new viewpoint can cover (0: a registered one
+// can): unseen (class kUnseen), or needing diffuse (specular) samples while no viewpoint that sees
+// it cleanly (visible[i][v], one mask per viewpoint) has a placeable light that would give one.
+std::vector<uint8_t> new_view_reasons(const MeshView &mesh, const std::vector<uint8_t> &classes,
+                                      const std::vector<std::vector<uint8_t>> &visible,
+                                      const std::vector<Viewpoint> &viewpoints, const LightSuggestionSettings &s);
+
+struct CoverageResult {
+  std::vector<CoverageCounts> counts;      // per vertex
+  std::vector<uint8_t> classes;            // per vertex, CoverageClass
+  std::vector<uint8_t> colors_rgba;        // per vertex, coverage_class_color
+  size_t class_counts[4] = {0, 0, 0, 0};   // indexed by CoverageClass
+  std::vector<Viewpoint> viewpoints;
+  size_t viewpoint = 0;                    // the suggestions' viewpoint (index into viewpoints)
+  LightSuggestion diffuse, specular;       // next lights for that viewpoint (valid == false: none)
+  bool diffuse_repeats = false, specular_repeats = false;  // repeats a light that failed (see suggest_light_learning)
+  int recommended = -1;                    // the one to take next: 0 diffuse, 1 specular, -1 none
+  std::vector<std::array<float, 3>> followed;  // earlier suggestions followed by photos (world)
+  size_t poor_diffuse = 0, poor_specular = 0;  // see CoverageNeeds
+  size_t failed_diffuse = 0, failed_specular = 0;  // uncovered vertices a photo's light should have covered
+  std::vector<uint32_t> new_view_vertices; // vertices only a new viewpoint can cover, ascending
+  std::vector<uint8_t> new_view_reasons;   // NewViewReason bits, parallel to new_view_vertices
+  size_t new_view_mixed = 0;               // of the seen ones: seen only in mixed pixels (silhouettes, borders)
+  bool has_view_hint = false;
+  float view_hint_world[3] = {0, 0, 0};    // direction from the object towards a good new camera
+  size_t view_hint_vertices = 0;           // new-view vertices facing it (N.D >= 0.5)
+  std::string light_file;                  // the .lp used
+  std::string suggestion_file, vertex_list_file;  // written files ("" when not written)
+  std::string report;                      // human-readable (also in the suggestion file)
+  std::string visibility_backend;
+  double seconds_visibility = 0, seconds_gather = 0, seconds_suggest = 0;
+};
+
+// Visibility back end as make_visibility_backend does for the fit (GL when `get_proc` is given).
+std::unique_ptr<VisibilityBackend> make_coverage_visibility(const MeshView &mesh, const CoverageSettings &settings,
+                                                            const std::function<void *(const char *)> &get_proc,
+                                                            const LogFn &log);
+
+// Runs everything and, when settings.write_files, writes the suggestion file (key: value lines
+// plus the report) and beside it the list of vertices only a new viewpoint can cover
+// (<suggestion file stem>_new_view_vertices.txt), both atomically. Suggestions learn from the
+// viewpoint's photos and, with settings.learn_from_previous, from the previous suggestion file at
+// the same path (suggest_light_learning); `recommended` is the valid suggestion promising more
+// weighted coverage that does not repeat a failed light. Needs a mesh with normals and at least
+// one raster (InputError otherwise, as validate_input). Throws InputError when dq/sq do not have
+// one value per vertex, when settings.viewpoint_raster is out of range, or when no .lp has an
+// entry for every raster.
+CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &settings, VisibilityBackend &visibility,
+                            const ProgressFn &progress, const LogFn &log);
+
+// The default suggestion file: <project folder>/<project name>_next_light.txt
+// ("vertex_brdf_next_light.txt" when no project path is known).
+std::string default_suggestion_path(const std::string &project_path);
+
+// Keys of the suggestion file ("key: value" lines): read back by tests and scripts.
+// Returns the value of `key`, or "" when absent.
+std::string suggestion_value(const std::string &suggestion_text, const std::string &key);
+
+// --- Importing new photos of a registered viewpoint (the between-shots step) ---
+
+// Image files (png, jpg, jpeg, tif, tiff, bmp; any case) in `folder`, sorted by name, that are not
+// already the photo of one of `rasters` (compared by absolute, symlink-resolved path). Throws
+// InputError naming the folder when it cannot be read.
+std::vector<std::string> new_photos_in_folder(const std::string &folder, const std::vector<Raster> &rasters);
+
+// Light directions estimated from the reflective sphere (sphere_lights.h) for the photos
+// photos[wanted[i]] of one viewpoint with shot `shot`. The sphere is located on all `photos`
+// together (median/max images and the highlights' track), or given by `manual` when its radius
+// is > 0 (image pixels, top-left origin). Returns one .lp entry per wanted photo, named by its path
+// relative to `lp_folder`, direction in the camera frame. What was found goes to `log`. Throws
+// InputError naming the photo when it has no usable highlight, or when no sphere is found.
+std::vector<LightEntry> sphere_light_entries(const std::vector<std::string> &photos, const std::vector<size_t> &wanted,
+                                             const Shot &shot, const SphereCircle &manual,
+                                             const std::string &lp_folder, const LogFn &log);
+
+// Entries of `existing` (kept in order, except those naming the same image file as an entry of
+// `added`) followed by `added`.
+std::vector<LightEntry> merge_light_entries(const std::vector<LightEntry> &existing, const std::vector<LightEntry> &added);
+
+} // namespace vbrdf

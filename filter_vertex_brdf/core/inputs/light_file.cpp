@@ -1,0 +1,153 @@
+#include "inputs/light_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <dirent.h>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <sys/stat.h>
+
+#include "base/errors.h"
+#include "base/file_util.h"
+#include "io/output_ply.h"
+
+namespace vbrdf {
+
+namespace {
+[[noreturn]] void fail(const std::string &path, int line, const std::string &what) {
+  throw InputError("Light file '" + path + "', line " + std::to_string(line) + ": " + what +
+                   ". Expected an RTI .lp file: first line N, then N lines 'image_file lx ly lz'.");
+}
+
+bool is_blank(const std::string &s) {
+  return std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); });
+}
+} // namespace
+
+std::vector<LightEntry> read_light_file(const std::string &path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("Cannot open light file '" + path + "': check the path given in 'lightFile'.");
+  std::string line;
+  int line_no = 0;
+  long count = -1;
+  while (count < 0 && std::getline(in, line)) {
+    ++line_no;
+    if (is_blank(line)) continue;
+    std::istringstream ls(line);
+    if (!(ls >> count) || count <= 0) fail(path, line_no, "the first line must be the number of lights");
+  }
+  if (count < 0) fail(path, line_no, "the file is empty");
+
+  std::vector<LightEntry> lights;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (is_blank(line)) continue;
+    if (long(lights.size()) == count)
+      fail(path, line_no, "more light lines than the count (" + std::to_string(count) + ") on the first line");
+    // The image name may contain spaces: the last three tokens are the direction.
+    std::string name = line, tokens[3];
+    for (int k = 2; k >= 0; --k) {
+      while (!name.empty() && std::isspace((unsigned char)name.back())) name.pop_back();
+      const size_t start = name.find_last_of(" \t");
+      if (start == std::string::npos) fail(path, line_no, "expected 'image_file lx ly lz'");
+      tokens[k] = name.substr(start + 1);
+      name.erase(start);
+    }
+    while (!name.empty() && std::isspace((unsigned char)name.back())) name.pop_back();
+    const size_t first = name.find_first_not_of(" \t");
+    if (first == std::string::npos) fail(path, line_no, "expected 'image_file lx ly lz'");
+    LightEntry e;
+    e.image = name.substr(first);
+    for (int k = 0; k < 3; ++k) {
+      char *end = nullptr;
+      e.dir_cam[k] = std::strtof(tokens[k].c_str(), &end);
+      if (end == tokens[k].c_str() || *end != '\0' || !std::isfinite(e.dir_cam[k]))
+        fail(path, line_no, "'" + tokens[k] + "' is not a number");
+    }
+    const float len = std::sqrt(e.dir_cam[0] * e.dir_cam[0] + e.dir_cam[1] * e.dir_cam[1] + e.dir_cam[2] * e.dir_cam[2]);
+    if (!(len > 1e-6f)) fail(path, line_no, "the light direction has zero length");
+    for (float &c : e.dir_cam) c /= len;
+    lights.push_back(e);
+  }
+  if (long(lights.size()) != count)
+    fail(path, line_no, "the first line says " + std::to_string(count) + " lights but " +
+                            std::to_string(lights.size()) + " light lines follow");
+  return lights;
+}
+
+void write_light_file(const std::string &path, const std::vector<LightEntry> &lights) {
+  std::ostringstream out;
+  out << lights.size() << "\n";
+  out.precision(9);
+  for (const LightEntry &e : lights)
+    out << e.image << " " << e.dir_cam[0] << " " << e.dir_cam[1] << " " << e.dir_cam[2] << "\n";
+  write_text_file_atomically(path, out.str());
+}
+
+int find_light_for_image(const std::vector<LightEntry> &lights, const std::string &image_path) {
+  const std::string name = file_name_of(image_path);
+  for (size_t i = 0; i < lights.size(); ++i)
+    if (file_name_of(lights[i].image) == name) return int(i);
+  const std::string lower = to_lower(name);
+  for (size_t i = 0; i < lights.size(); ++i)
+    if (to_lower(file_name_of(lights[i].image)) == lower) return int(i);
+  return -1;
+}
+
+namespace {
+std::vector<std::string> lp_files_in(const std::string &dir) {
+  std::vector<std::string> found;
+  if (DIR *d = ::opendir(dir.c_str())) {
+    while (dirent *e = ::readdir(d)) {
+      const std::string n = e->d_name;
+      if (n.size() > 3 && to_lower(n.substr(n.size() - 3)) == ".lp") found.push_back(join_path(dir, n));
+    }
+    ::closedir(d);
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+double modification_time(const std::string &path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) return 0;
+  return double(st.st_mtim.tv_sec) + 1e-9 * double(st.st_mtim.tv_nsec);
+}
+
+// "" when `lp_path` has an entry for every raster, else why not.
+std::string why_not_covering(const std::string &lp_path, const std::vector<Raster> &rasters) {
+  std::vector<LightEntry> lights;
+  try {
+    lights = read_light_file(lp_path);
+  } catch (const InputError &e) {
+    return e.what();
+  }
+  for (const Raster &r : rasters)
+    if (find_light_for_image(lights, r.image_path) < 0)
+      return "has no entry for raster '" + r.label + "' (image '" + file_name_of(r.image_path) + "')";
+  return "";
+}
+} // namespace
+
+std::string find_default_light_file(const std::vector<Raster> &rasters, const std::string &project_path,
+                                    std::vector<std::string> *checked) {
+  std::vector<std::string> dirs;
+  if (!project_path.empty()) dirs.push_back(directory_of(project_path));
+  for (const Raster &r : rasters) dirs.push_back(directory_of(r.image_path));
+  std::vector<std::pair<double, std::string>> candidates;  // (-time, path): newest first, then path order
+  std::set<std::string> seen_dirs, seen_files;
+  for (const std::string &d : dirs)
+    if (seen_dirs.insert(d).second)
+      for (const std::string &f : lp_files_in(d))
+        if (seen_files.insert(f).second) candidates.emplace_back(-modification_time(f), f);
+  std::sort(candidates.begin(), candidates.end());
+  for (const auto &candidate : candidates) {
+    const std::string why = why_not_covering(candidate.second, rasters);
+    if (why.empty()) return candidate.second;
+    if (checked) checked->push_back(candidate.second + ": " + why);
+  }
+  return "";
+}
+
+} // namespace vbrdf

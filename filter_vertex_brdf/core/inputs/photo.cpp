@@ -1,0 +1,171 @@
+#include "inputs/photo.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "base/errors.h"
+#include "base/file_util.h"
+
+namespace vbrdf {
+
+float srgb_to_linear(float c) {
+  c = std::min(std::max(c, 0.0f), 1.0f);
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+float linear_to_srgb(float c) {
+  if (!(c > 0)) return 0;  // also maps NaN to 0
+  if (c >= 1) return 1;
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level, int expected_width,
+                 int expected_height) {
+  if (!file_exists(path))
+    throw InputError("Photo '" + path + "' is missing: restore it or fix the raster's path in the project.");
+  cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (raw.empty()) throw InputError("Photo '" + path + "' cannot be decoded (unsupported or damaged file).");
+  if (raw.depth() != CV_8U && raw.depth() != CV_16U)
+    throw InputError("Photo '" + path + "' is neither 8- nor 16-bit per channel: convert it to 8-bit sRGB or "
+                     "16-bit linear PNG/TIFF.");
+  Photo photo;
+  photo.path = path;
+  switch (raw.channels()) {
+  case 1: cv::cvtColor(raw, photo.pixels, cv::COLOR_GRAY2RGB); break;
+  case 3: cv::cvtColor(raw, photo.pixels, cv::COLOR_BGR2RGB); break;
+  case 4: cv::cvtColor(raw, photo.pixels, cv::COLOR_BGRA2RGB); break;
+  default: throw InputError("Photo '" + path + "' has " + std::to_string(raw.channels()) + " channels; expected RGB.");
+  }
+  if (expected_width > 0 && (photo.width() != expected_width || photo.height() != expected_height))
+    throw InputError("Photo '" + path + "' is " + std::to_string(photo.width()) + "x" + std::to_string(photo.height()) +
+                     " but its raster's camera expects " + std::to_string(expected_width) + "x" +
+                     std::to_string(expected_height) + ": use the photo the camera was registered with.");
+
+  const bool sixteen = raw.depth() == CV_16U;
+  const int max_code = sixteen ? 65535 : 255;
+  photo.linear = encoding == PhotoEncoding::Linear || (encoding == PhotoEncoding::Auto && sixteen);
+  photo.lut.resize(size_t(max_code) + 1);
+  for (int c = 0; c <= max_code; ++c) {
+    const float v = float(c) / float(max_code);
+    photo.lut[size_t(c)] = photo.linear ? v : srgb_to_linear(v);
+  }
+  photo.saturation_code = std::max(1, int(std::ceil(saturation_level * max_code - 1e-3f)));
+  return photo;
+}
+
+namespace {
+template <typename T>
+PixelSample bilinear(const Photo &photo, float x, float y, uint8_t texels) {
+  PixelSample out;
+  // Pixel centres are at +0.5: shift to centre-based coordinates.
+  const float fx = x - 0.5f, fy = y - 0.5f;
+  const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= photo.width() || y0 + 1 >= photo.height() || (texels & 0xF) == 0) return out;
+  out.inside = true;
+  const float ax = fx - float(x0), ay = fy - float(y0);
+  float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
+  float total = 0;
+  for (int k = 0; k < 4; ++k) total += (texels >> k & 1u) ? w[k] : (w[k] = 0);
+  if (total < 1e-3f)  // kept texels carry (almost) no bilinear weight: average them instead
+    for (int k = 0; k < 4; ++k) w[k] = (texels >> k & 1u) ? 1.0f : 0.0f;
+  total = 0;
+  for (float wk : w) total += wk;
+  const T *rows[2] = {photo.pixels.ptr<T>(y0), photo.pixels.ptr<T>(y0 + 1)};
+  for (int k = 0; k < 4; ++k) {
+    if (w[k] == 0 && texels != 0xF) continue;
+    const T *px = rows[k / 2] + 3 * (x0 + (k % 2));
+    for (int c = 0; c < 3; ++c) {
+      if (int(px[c]) >= photo.saturation_code) out.saturated = true;
+      out.rgb[c] += w[k] / total * photo.lut[px[c]];
+    }
+  }
+  return out;
+}
+} // namespace
+
+cv::Mat photo_linear_rgb(const Photo &photo, cv::Mat *clipped) {
+  const int w = photo.width(), h = photo.height();
+  cv::Mat linear(h, w, CV_32FC3);
+  if (clipped) clipped->create(h, w, CV_8U);
+  const bool wide = photo.pixels.depth() == CV_16U;
+  for (int y = 0; y < h; ++y) {
+    float *out = linear.ptr<float>(y);
+    uint8_t *clip = clipped ? clipped->ptr<uint8_t>(y) : nullptr;
+    for (int x = 0; x < w; ++x) {
+      bool any = false;
+      for (int c = 0; c < 3; ++c) {
+        const int code = wide ? photo.pixels.ptr<uint16_t>(y)[3 * x + c] : photo.pixels.ptr<uint8_t>(y)[3 * x + c];
+        out[3 * x + c] = photo.lut[size_t(code)];
+        any = any || code >= photo.saturation_code;
+      }
+      if (clip) clip[x] = any ? 255 : 0;
+    }
+  }
+  return linear;
+}
+
+cv::Mat decode_to_linear(const cv::Mat &image, bool decode_srgb) {
+  if (image.empty()) return cv::Mat();
+  cv::Mat f;
+  if (image.depth() == CV_8U && decode_srgb) {
+    cv::Mat lut(1, 256, CV_32F);
+    for (int i = 0; i < 256; ++i) lut.at<float>(i) = srgb_to_linear(float(i) / 255.0f);
+    std::vector<cv::Mat> planes, decoded;
+    cv::split(image, planes);
+    for (const cv::Mat &p : planes) {
+      cv::Mat d;
+      cv::LUT(p, lut, d);
+      decoded.push_back(d);
+    }
+    cv::merge(decoded, f);
+  } else if (image.depth() == CV_8U) {
+    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()), 1.0 / 255);
+  } else if (image.depth() == CV_16U) {
+    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()), 1.0 / 65535);
+  } else if (image.depth() == CV_32F || image.depth() == CV_64F) {
+    image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()));
+  } else {
+    throw InputError("Unsupported image depth: expected 8-bit, 16-bit or float.");
+  }
+  return f;
+}
+
+PixelSample sample_bilinear(const Photo &photo, float x, float y, uint8_t texels) {
+  if (!std::isfinite(x) || !std::isfinite(y)) return PixelSample();
+  return photo.pixels.depth() == CV_16U ? bilinear<uint16_t>(photo, x, y, texels)
+                                        : bilinear<uint8_t>(photo, x, y, texels);
+}
+
+PhotoCache::PhotoCache(PhotoEncoding encoding, float saturation_level, size_t budget_bytes)
+    : encoding_(encoding), saturation_level_(saturation_level), budget_(budget_bytes) {}
+
+std::shared_ptr<const Photo> PhotoCache::get(const std::string &path, int expected_width, int expected_height) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++tick_;
+  for (auto &e : entries_)
+    if (e.first == path) {
+      e.second.last_use = tick_;
+      return e.second.photo;
+    }
+  auto photo = std::make_shared<const Photo>(
+      load_photo(path, encoding_, saturation_level_, expected_width, expected_height));
+  ++loads_;
+  const size_t bytes = photo->pixels.total() * photo->pixels.elemSize() + photo->lut.size() * sizeof(float);
+  // Evict least recently used photos until the new one fits (a photo in use elsewhere stays
+  // alive through its shared_ptr even when evicted).
+  while (!entries_.empty() && used_ + bytes > budget_) {
+    auto oldest = std::min_element(entries_.begin(), entries_.end(), [](const auto &a, const auto &b) {
+      return a.second.last_use < b.second.last_use;
+    });
+    used_ -= oldest->second.bytes;
+    entries_.erase(oldest);
+  }
+  entries_.push_back({path, Entry{photo, bytes, tick_}});
+  used_ += bytes;
+  return photo;
+}
+
+} // namespace vbrdf

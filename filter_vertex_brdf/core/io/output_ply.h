@@ -1,0 +1,27 @@
+#pragma once
+// Output PLY: the input geometry (never changed) with per-vertex results as named properties any
+// PLY reader sees, written atomically (temporary file in the same folder, then rename), so a
+// partial file is never left under the final name.
+#include <string>
+#include <vector>
+
+#include "base/mesh_view.h"
+
+namespace vbrdf {
+
+struct VertexAttribute {
+  std::string name;            // PLY property name
+  std::vector<float> values;   // one per vertex
+};
+
+// Writes a binary little-endian PLY with x y z, nx ny nz, red green blue alpha (uchar, from
+// `colors_rgba`, which must have 4 * vertex_count entries), faces, and every attribute as a float
+// property. Throws ProcessingError (naming the path) on I/O failure or when an attribute holds a
+// NaN/Inf (the caller must have replaced them by documented sentinels).
+void write_result_ply(const std::string &path, const MeshView &mesh, const std::vector<uint8_t> &colors_rgba,
+                      const std::vector<VertexAttribute> &attributes);
+
+// Writes a text file atomically (used for reports).
+void write_text_file_atomically(const std::string &path, const std::string &text);
+
+} // namespace vbrdf

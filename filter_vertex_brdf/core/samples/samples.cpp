@@ -1,0 +1,279 @@
+#include "samples/samples.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "base/errors.h"
+#include "base/vec3.h"
+
+namespace vbrdf {
+
+namespace {
+
+void report(const ProgressFn &progress, float fraction, const char *stage) {
+  if (progress && !progress(std::min(std::max(fraction, 0.0f), 1.0f), stage))
+    throw ProcessingError("cancelled by the user");
+}
+
+void pack_bits(const std::vector<uint8_t> &flags, uint64_t *words) {
+  for (size_t v = 0; v < flags.size(); ++v)
+    if (flags[v]) words[v / 64] |= uint64_t(1) << (v % 64);
+}
+
+int bit_index(uint16_t flag) {
+  int i = 0;
+  while (flag > 1) flag >>= 1, ++i;
+  return i;
+}
+} // namespace
+
+bool VisibilityMasks::sees_any(size_t r, size_t first, size_t count) const {
+  if (count == 0) return false;
+  const uint64_t *w = &seen[r * words()];
+  const size_t last = first + count - 1;
+  for (size_t i = first / 64; i <= last / 64; ++i) {
+    uint64_t bits = w[i];
+    if (i == first / 64) bits &= ~uint64_t(0) << (first % 64);
+    if (i == last / 64 && last % 64 != 63) bits &= (uint64_t(1) << (last % 64 + 1)) - 1;
+    if (bits) return true;
+  }
+  return false;
+}
+
+uint8_t VisibilityMasks::own_texels(size_t r, size_t v) const {
+  if (!is_mixed(r, v)) return kAllFootprintTexels;
+  if (r >= footprints.size()) return 0;  // masks built without footprint lists: nothing known
+  const std::vector<uint32_t> &list = footprints[r];
+  const auto it = std::lower_bound(list.begin(), list.end(), uint32_t(v) << 4);
+  return (it != list.end() && (*it >> 4) == v) ? uint8_t(*it & 0xFu) : uint8_t(0);
+}
+
+namespace {
+// Combines the camera pass with the per-vertex frustum and facing tests into `seen`, counting why
+// vertices are not seen (off image first, then back-facing, then occluded).
+void classify_seen(const MeshView &mesh, const Raster &raster, const std::vector<uint8_t> &clear, uint64_t *seen_words,
+                   uint64_t *mixed_words, uint32_t counts[4]) {
+  float centre[3];
+  camera_centre(raster.shot, centre);
+  uint64_t off = 0, back = 0, occ = 0, seen = 0;
+  const long long words = (long long)((mesh.vertex_count + 63) / 64);
+#pragma omp parallel for reduction(+ : off, back, occ, seen) schedule(static)
+  for (long long w = 0; w < words; ++w) {
+    uint64_t bits = 0, mixed_bits = 0;
+    const size_t end = std::min(mesh.vertex_count, size_t(w + 1) * 64);
+    for (size_t v = size_t(w) * 64; v < end; ++v) {
+      const float *p = mesh.positions + 3 * v, *n = mesh.normals + 3 * v;
+      const ImagePoint ip = project_to_image(raster.shot, p);
+      if (!ip.in_front || !(ip.x >= 0 && ip.y >= 0 && ip.x < float(raster.width()) && ip.y < float(raster.height()))) {
+        ++off;
+        continue;
+      }
+      const float e[3] = {centre[0] - p[0], centre[1] - p[1], centre[2] - p[2]};
+      if (dot3(n, e) <= 0) {
+        ++back;
+        continue;
+      }
+      if (!clear[v]) {
+        ++occ;
+        continue;
+      }
+      bits |= uint64_t(1) << (v % 64);
+      if (clear[v] & kFootprintPartial) mixed_bits |= uint64_t(1) << (v % 64);
+      ++seen;
+    }
+    seen_words[w] = bits;
+    mixed_words[w] = mixed_bits;
+  }
+  counts[0] = uint32_t(off), counts[1] = uint32_t(back), counts[2] = uint32_t(occ), counts[3] = uint32_t(seen);
+}
+
+// The sorted (v << 4 | own-texel mask) list of the vertices marked in `mixed_words`.
+std::vector<uint32_t> footprint_list(const std::vector<uint8_t> &clear, const uint64_t *mixed_words, size_t words) {
+  std::vector<uint32_t> list;
+  for (size_t w = 0; w < words; ++w)
+    for (uint64_t bits = mixed_words[w]; bits; bits &= bits - 1) {
+      const size_t v = w * 64 + size_t(__builtin_ctzll(bits));
+      list.push_back(uint32_t(v) << 4 | (clear[v] & 0xFu));
+    }
+  return list;
+}
+} // namespace
+
+VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                   const std::vector<LightSource> &lights,
+                                   VisibilityBackend &backend, const ProgressFn &progress) {
+  VisibilityMasks masks;
+  masks.vertex_count = mesh.vertex_count;
+  masks.raster_count = rasters.size();
+  masks.seen.assign(masks.words() * rasters.size(), 0);
+  masks.lit.assign(masks.words() * rasters.size(), 0);
+  masks.mixed.assign(masks.words() * rasters.size(), 0);
+  masks.footprints.assign(rasters.size(), {});
+  if (mesh.vertex_count >= (size_t(1) << 28))
+    throw InputError("Meshes of more than 268 million vertices are not supported.");
+  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded, &masks.seen_count}) v->assign(rasters.size(), 0);
+  std::vector<uint8_t> buffer(mesh.vertex_count);
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    report(progress, float(r) / float(rasters.size()), "visibility");
+    std::fill(buffer.begin(), buffer.end(), 0);
+    backend.camera_pass(rasters[r].shot, buffer.data());
+    uint32_t counts[4];
+    classify_seen(mesh, rasters[r], buffer, &masks.seen[r * masks.words()], &masks.mixed[r * masks.words()], counts);
+    masks.off_image[r] = counts[0], masks.back_facing[r] = counts[1], masks.occluded[r] = counts[2];
+    masks.seen_count[r] = counts[3];
+    masks.footprints[r] = footprint_list(buffer, &masks.mixed[r * masks.words()], masks.words());
+    if (counts[3] == 0) continue;  // a photo that sees nothing needs no shadow pass
+    std::fill(buffer.begin(), buffer.end(), 0);
+    backend.light_pass(lights[r], buffer.data());
+    pack_bits(buffer, &masks.lit[r * masks.words()]);
+  }
+  report(progress, 1.0f, "visibility");
+  return masks;
+}
+
+uint16_t make_sample(const float position[3], const float normal_in[3], const Raster &raster, uint16_t raster_index,
+                     const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
+                     const GatherSettings &settings, Sample &out, uint8_t own_texels) {
+  out = Sample{{0, 0, 0}, 0, 0, raster_index, 0};
+  float n[3] = {normal_in[0], normal_in[1], normal_in[2]};
+  normalize3(n);
+  float centre[3];
+  camera_centre(raster.shot, centre);
+  float e[3] = {centre[0] - position[0], centre[1] - position[1], centre[2] - position[2]};
+  normalize3(e);
+
+  uint16_t flags = 0;
+  const ImagePoint ip = project_to_image(raster.shot, position);
+  if (!ip.in_front || !(ip.x >= 0 && ip.y >= 0 && ip.x < float(raster.width()) && ip.y < float(raster.height())))
+    flags |= kOffImage;
+  if (dot3(n, e) <= 0) flags |= kBackFacing;
+  if (!camera_clear) flags |= kOccluded;
+
+  float light_dir[3];
+  light_direction_at(light, position, light_dir);
+  const float d = dot3(n, light_dir);
+  const float r[3] = {2 * d * n[0] - light_dir[0], 2 * d * n[1] - light_dir[1], 2 * d * n[2] - light_dir[2]};
+  const float s = dot3(r, e);
+  out.n_dot_l = d;
+  out.r_dot_e = s;
+  if (d <= 0) flags |= kAttachedShadow;
+  if (!light_clear) flags |= kCastShadow;
+  if (d > 0 && d < settings.diffuse_threshold) flags |= kGrazing;
+  if (d > 0 && s > settings.specular_threshold) flags |= kHighlight;
+
+  if (!(flags & kNotSeen)) {
+    own_texels &= kAllFootprintTexels;
+    const bool partial = own_texels != kAllFootprintTexels;
+    const bool own_only = partial && settings.own_surface_texels && own_texels != 0;
+    if (partial) flags |= own_only ? kRimFootprint : kMixedPixel;
+    const PixelSample px = sample_bilinear(photo, ip.x, ip.y, own_only ? own_texels : kAllFootprintTexels);
+    if (!px.inside) flags |= kOffImage;  // bilinear footprint crosses the image border
+    if (px.saturated) flags |= kSaturated;
+    for (int c = 0; c < 3; ++c) out.rgb[c] = px.rgb[c];
+  }
+  out.flags = flags;
+  return flags;
+}
+
+GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
+                           const std::vector<LightSource> &lights, const VisibilityMasks &masks,
+                           const GatherSettings &settings, PhotoCache &photos,
+                           const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (rasters.size() > 65535) throw InputError("More than 65535 photos in one project are not supported.");
+  GatherStats stats;
+  stats.raster_seen_vertices.assign(rasters.size(), 0);
+  const size_t raster_count = std::max<size_t>(rasters.size(), 1);
+  // A chunk holds a dense vertices x rasters block before compaction: size it to the budget.
+  const size_t chunk_vertices = std::max<size_t>(
+      1024, settings.chunk_sample_bytes / (sizeof(Sample) * raster_count));
+  std::vector<Sample> dense;
+  SampleChunk chunk;
+
+  for (size_t first = 0; first < mesh.vertex_count; first += chunk_vertices) {
+    const size_t count = std::min(chunk_vertices, mesh.vertex_count - first);
+    dense.resize(count * rasters.size());
+    for (size_t r = 0; r < rasters.size(); ++r) {
+      report(progress, (float(first) + float(count) * float(r) / float(raster_count)) / float(mesh.vertex_count),
+             "gathering samples");
+      const Raster &raster = rasters[r];
+      if (!masks.sees_any(r, first, count)) {  // skip: do not even load the photo
+        ++stats.rasters_skipped;
+        for (size_t i = 0; i < count; ++i) dense[i * rasters.size() + r].flags = kOccluded;
+        continue;
+      }
+      const auto photo = photos.get(raster.image_path, raster.width(), raster.height());
+      const LightSource &light = lights[r];
+#pragma omp parallel for schedule(dynamic, 1024)
+      for (long long i = 0; i < (long long)count; ++i) {
+        const size_t v = first + size_t(i);
+        Sample &out = dense[size_t(i) * rasters.size() + r];
+        if (!masks.is_seen(r, v)) {
+          out.flags = kOccluded;  // not seen: never stored (why is counted by the visibility pass)
+          continue;
+        }
+        make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo, true,
+                    masks.is_lit(r, v), settings, out, masks.own_texels(r, v));
+      }
+    }
+    // Compact: keep samples seen by the camera, in vertex order.
+    chunk.first_vertex = uint32_t(first);
+    chunk.vertex_count = uint32_t(count);
+    chunk.offsets.assign(count + 1, 0);
+    chunk.samples.clear();
+    for (size_t i = 0; i < count; ++i) {
+      for (size_t r = 0; r < rasters.size(); ++r) {
+        const Sample &s = dense[i * rasters.size() + r];
+        if (s.flags & kNotSeen) continue;
+        for (uint16_t f = s.flags; f; f &= uint16_t(f - 1)) ++stats.flag_counts[bit_index(uint16_t(f & -f))];
+        chunk.samples.push_back(s);
+        ++stats.raster_seen_vertices[r];
+      }
+      chunk.offsets[i + 1] = uint32_t(chunk.samples.size());
+    }
+    stats.stored += chunk.samples.size();
+    ++stats.chunks;
+    consume(chunk);
+  }
+  report(progress, 1.0f, "gathering samples");
+  stats.pairs = uint64_t(mesh.vertex_count) * rasters.size();
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    stats.flag_counts[bit_index(kOffImage)] += masks.off_image[r];
+    stats.flag_counts[bit_index(kBackFacing)] += masks.back_facing[r];
+    stats.flag_counts[bit_index(kOccluded)] += masks.occluded[r];
+  }
+  stats.photo_loads = photos.loads();
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+void apply_light_falloff(SampleChunk &chunk, const MeshView &mesh, const std::vector<LightSource> &lights) {
+  if (!any_positional(lights)) return;
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
+    const float *x = mesh.positions + 3 * (size_t(chunk.first_vertex) + size_t(i));
+    for (uint32_t k = chunk.offsets[size_t(i)]; k < chunk.offsets[size_t(i) + 1]; ++k) {
+      Sample &s = chunk.samples[k];
+      const float e = light_irradiance_at(lights[s.raster], x);
+      for (float &c : s.rgb) c /= e;
+    }
+  }
+}
+
+size_t prefer_clean_samples(SampleChunk &chunk, int min_clean) {
+  size_t demoted = 0;
+#pragma omp parallel for reduction(+ : demoted) schedule(dynamic, 1024)
+  for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
+    Sample *first = chunk.samples.data() + chunk.offsets[size_t(i)];
+    Sample *last = chunk.samples.data() + chunk.offsets[size_t(i) + 1];
+    int clean = 0;
+    for (const Sample *s = first; s != last; ++s) clean += is_diffuse_sample(*s) && !(s->flags & kRimFootprint);
+    if (clean < min_clean) continue;
+    for (Sample *s = first; s != last; ++s)
+      if (s->flags & kRimFootprint) s->flags |= kMixedPixel, ++demoted;
+  }
+  return demoted;
+}
+
+} // namespace vbrdf

@@ -1,0 +1,158 @@
+#pragma once
+// Samples: one per (vertex, photo) pair in which the vertex is seen by the photo's camera.
+// Everything later stages read (colour, fit, coverage) comes from here.
+//
+// Memory: visibility is computed per photo for all vertices and kept as bit masks
+// (2 bits per vertex and photo); pixel samples are then produced per vertex chunk, so the number
+// of photos and vertices is limited by disk and time, not by memory. A sample is 24 bytes.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "inputs/camera.h"
+#include "inputs/light_source.h"
+#include "base/mesh_view.h"
+#include "inputs/photo.h"
+#include "visibility/visibility.h"
+
+namespace vbrdf {
+
+enum SampleFlag : uint16_t {
+  kOffImage = 1u << 0,        // projects outside the photo or behind the camera (never stored)
+  kBackFacing = 1u << 1,      // N.E <= 0 (never stored)
+  kOccluded = 1u << 2,        // hidden by other geometry from the camera (never stored)
+  kAttachedShadow = 1u << 3,  // N.L <= 0: faces away from the light
+  kCastShadow = 1u << 4,      // other geometry between the vertex and the light
+  kSaturated = 1u << 5,       // a channel is clipped in the bilinear footprint
+  kGrazing = 1u << 6,         // 0 < N.L < T_d
+  kHighlight = 1u << 7,       // R.E > T_s (specular sample)
+  kMixedPixel = 1u << 8,      // the pixel footprint also covers background/another surface, and
+                              //   the colour includes it (no own-surface texel, or plain bilinear)
+  kRimFootprint = 1u << 9,    // the footprint straddles a depth jump; the colour comes from its
+                              //   own-surface texels only (GatherSettings::own_surface_texels)
+};
+constexpr uint16_t kNotSeen = kOffImage | kBackFacing | kOccluded;
+constexpr uint16_t kShadowed = kAttachedShadow | kCastShadow;
+
+struct Sample {
+  float rgb[3];      // linear pixel colour (bilinear)
+  float n_dot_l;     // d = N.L
+  float r_dot_e;     // s = R.E, R = 2(N.L)N - L, E = unit vector from the vertex to the camera centre
+  uint16_t raster;   // index of the photo
+  uint16_t flags;    // SampleFlag bits
+};
+static_assert(sizeof(Sample) == 24, "Sample must stay compact");
+
+// Usable for the diffuse colour: lit, not grazing, not a highlight, not saturated, clean pixel.
+inline bool is_diffuse_sample(const Sample &s) {
+  return (s.flags & (kShadowed | kSaturated | kGrazing | kHighlight | kMixedPixel)) == 0;
+}
+// Usable as specular evidence: lit, unsaturated, clean highlight.
+inline bool is_specular_sample(const Sample &s) {
+  return (s.flags & (kShadowed | kSaturated | kMixedPixel)) == 0 && (s.flags & kHighlight) != 0;
+}
+
+struct GatherSettings {
+  float specular_threshold = 0.9f;   // T_s on R.E
+  float diffuse_threshold = 0.5f;    // T_d on N.L
+  PhotoEncoding encoding = PhotoEncoding::Auto;
+  float saturation_level = 0.99f;    // fraction of the maximum code value counted as clipped
+  size_t photo_cache_bytes = size_t(2) << 30;  // decoded photos kept in memory
+  size_t chunk_sample_bytes = size_t(256) << 20; // target size of one chunk's samples
+  // Where a vertex's 2x2 bilinear footprint straddles a depth jump (silhouette, contact), take
+  // the colour from the footprint texels on the vertex's own surface, re-weighted (the fit's
+  // choice). false: plain bilinear over all 4 texels, mixed or not (the RTI evaluation protocol:
+  // held-out photos are compared as sampled, contamination included).
+  bool own_surface_texels = true;
+};
+
+// Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
+// not occluded (the camera pass combined with the per-vertex frustum/facing test), `lit` = not in
+// cast shadow. Per-photo counts say why vertices were not seen.
+struct VisibilityMasks {
+  size_t vertex_count = 0;
+  size_t raster_count = 0;
+  std::vector<uint64_t> seen;  // raster-major: word (r * words() + v / 64), bit v % 64
+  std::vector<uint64_t> lit;
+  std::vector<uint64_t> mixed;  // seen, but the pixel footprint straddles a depth jump
+  // Per raster, for its mixed vertices only, sorted: (v << 4) | mask of the footprint texels on the
+  // vertex's own surface (visibility.h). Sparse: only rims and contacts are listed.
+  std::vector<std::vector<uint32_t>> footprints;
+  std::vector<uint32_t> off_image, back_facing, occluded, seen_count;  // per raster
+  size_t words() const { return (vertex_count + 63) / 64; }
+  bool is_seen(size_t r, size_t v) const { return (seen[r * words() + v / 64] >> (v % 64)) & 1u; }
+  bool is_lit(size_t r, size_t v) const { return (lit[r * words() + v / 64] >> (v % 64)) & 1u; }
+  bool is_mixed(size_t r, size_t v) const { return (mixed[r * words() + v / 64] >> (v % 64)) & 1u; }
+  // Own-surface texels of the footprint of vertex v in raster r: kAllFootprintTexels unless mixed.
+  uint8_t own_texels(size_t r, size_t v) const;
+  // True when raster r sees at least one vertex in [first, first + count).
+  bool sees_any(size_t r, size_t first, size_t count) const;
+};
+
+// Progress: fraction in [0,1] and a short label. Returns false to cancel (core then throws
+// ProcessingError("cancelled")).
+using ProgressFn = std::function<bool(float fraction, const char *stage)>;
+
+// Runs the camera and light depth passes for every raster. lights[r] is the light of raster r.
+VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                   const std::vector<LightSource> &lights,
+                                   VisibilityBackend &backend, const ProgressFn &progress = {});
+
+// Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`,
+// lit by `light` (its direction at the vertex: light_direction_at). The colour is the photo's,
+// NOT divided by the light's fall-off (apply_light_falloff does that, after colour correction).
+// `camera_clear`/`light_clear` come from the depth passes (occlusion / cast shadow);
+// `own_texels` is the footprint mask of the camera pass (kAllFootprintTexels: a clean footprint).
+// A partial footprint gives kRimFootprint and the own texels' colour when
+// settings.own_surface_texels and any own texel remains, else kMixedPixel and the plain bilinear
+// colour. Returns the flags; when the result has any kNotSeen flag, `out` holds only flags and
+// geometry terms.
+uint16_t make_sample(const float position[3], const float normal[3], const Raster &raster, uint16_t raster_index,
+                     const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
+                     const GatherSettings &settings, Sample &out, uint8_t own_texels = kAllFootprintTexels);
+
+struct SampleChunk {
+  uint32_t first_vertex = 0;
+  uint32_t vertex_count = 0;
+  std::vector<uint32_t> offsets;  // vertex_count + 1 entries: samples of vertex first_vertex + i
+  std::vector<Sample> samples;    //   are samples[offsets[i] .. offsets[i+1])
+};
+
+struct GatherStats {
+  uint64_t pairs = 0;             // vertex x raster pairs examined
+  uint64_t stored = 0;            // samples stored (seen by the camera)
+  uint64_t flag_counts[16] = {};  // pairs with each SampleFlag bit set (index = bit position)
+  std::vector<uint32_t> raster_seen_vertices;  // per raster: vertices it sees
+  size_t chunks = 0;
+  size_t rasters_skipped = 0;     // raster x chunk pairs skipped because the raster sees no vertex there
+  size_t photo_loads = 0;
+  double seconds = 0;
+};
+
+// Streams samples chunk by chunk (vertex ranges sized by settings.chunk_sample_bytes) to
+// `consume`. Chunks arrive in vertex order; the chunk object is reused after `consume` returns,
+// so `consume` may modify it (the fit corrects the samples' colours in place).
+// Only pairs the masks mark as seen are sampled; a photo that sees no vertex of a chunk is not
+// even loaded (GatherStats::rasters_skipped counts such raster x chunk pairs).
+GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
+                           const std::vector<LightSource> &lights, const VisibilityMasks &masks,
+                           const GatherSettings &settings, PhotoCache &photos,
+                           const std::function<void(SampleChunk &)> &consume, const ProgressFn &progress = {});
+
+// Point lights: divides each sample's colour by the irradiance of its light at its vertex
+// (light_irradiance_at), so that the fit sees every sample as under unit light, as with
+// directional lights. Call it after colour correction (which need not be linear). Flags and the
+// saturation test (made on the photo's values) are unchanged. A no-op for directional lights;
+// the factor is finite and positive (clamped distance), so no NaN arises.
+void apply_light_falloff(SampleChunk &chunk, const MeshView &mesh, const std::vector<LightSource> &lights);
+
+// Rim samples (kRimFootprint: colour from part of a footprint that straddles a silhouette or
+// contact) still carry some of the other side through the sensor's pixel area. A vertex with at
+// least `min_clean` clean diffuse samples (is_diffuse_sample without kRimFootprint) does not need
+// them: its rim samples are marked kMixedPixel (left out by the strict fit and the diffuse
+// estimate, like every back end's). Vertices with fewer keep them. Returns the samples demoted.
+size_t prefer_clean_samples(SampleChunk &chunk, int min_clean = 2);
+
+} // namespace vbrdf

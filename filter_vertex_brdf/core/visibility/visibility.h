@@ -1,0 +1,81 @@
+#pragma once
+// Occlusion tests for every vertex: from a camera (is another part of the mesh in front of it?)
+// and from a light, directional or point (is the vertex in cast shadow?). Two back ends share this contract:
+// GL depth passes (visibility_gl.h) and a CPU ray-cast reference (visibility_cpu.h) used by tests.
+// Frustum, back-facing and attached-shadow (N.L <= 0) tests are NOT done here (samples.cpp does
+// them per vertex); these passes only answer "is other geometry in the way?".
+#include <cstdint>
+#include <memory>
+
+#include "inputs/camera.h"
+#include "inputs/light_source.h"
+#include "base/mesh_view.h"
+
+namespace vbrdf {
+
+struct VisibilitySettings {
+  // Depth tolerance as a fraction of the mesh bounding-box diagonal: a vertex counts as visible
+  // when it is at most this much behind the first surface along the ray.
+  float depth_tolerance = 0.002f;
+  // Resolution (square) of the light-view orthographic depth map over the mesh bounds.
+  // 0 = automatic (resolved_shadow_map_size).
+  int shadow_map_size = 0;
+};
+
+// The shadow-map resolution to use: `settings.shadow_map_size` when positive; for 0, the power of
+// two that makes a texel at most a quarter of the median edge length over the mesh's bounding
+// sphere, clamped to [1024, 4096] (a shadow edge is then placed to within a fraction of a vertex
+// spacing; finer maps cost time, quadratically, and change few vertices' flags). Throws InputError when negative.
+int resolved_shadow_map_size(const MeshView &mesh, const VisibilitySettings &settings);
+
+// Camera-pass output codes (VisibilityBackend::camera_pass).
+constexpr uint8_t kCameraHidden = 0;
+constexpr uint8_t kCameraClear = 1;
+constexpr uint8_t kFootprintPartial = 0x10;  // | 4-bit mask of own-surface footprint texels
+constexpr uint8_t kAllFootprintTexels = 0xF;
+
+// The bilinear footprint of image point (x, y) (image pixels, top-left origin, centres at +0.5)
+// is the 2x2 block whose top-left texel is (floor(x - 0.5), floor(y - 0.5)). Bit k of a footprint
+// mask stands for texel (x0 + k % 2, y0 + k / 2).
+inline uint8_t footprint_texel_bit(int k) { return uint8_t(1u << k); }
+
+// The camera-pass code of a vertex that is not hidden, from the mask of its own-surface texels.
+inline uint8_t camera_code_of(uint8_t own_texels) {
+  return own_texels == kAllFootprintTexels ? kCameraClear : uint8_t(kFootprintPartial | own_texels);
+}
+
+// How far a texel's surface depth may differ from the vertex's depth and still count as the
+// vertex's own (continuous) surface: across 1.5 texels the depth of a surface seen at up to 79
+// degrees from the view axis (slope tan = 5) changes by 1.5 * 5 * (world size of a texel), plus
+// the depth tolerance. Creases and steep faces stay own surface; background and separate
+// surfaces (depth jumps) do not.
+inline float own_surface_depth_slack(float vertex_depth, float focal_px, float tolerance) {
+  return tolerance + 1.5f * vertex_depth / focal_px * 5.0f;
+}
+
+class VisibilityBackend {
+public:
+  virtual ~VisibilityBackend() = default;
+  virtual const char *name() const = 0;
+  // out[v] = kCameraHidden when other geometry hides vertex v from the camera of `shot`;
+  // kCameraClear when it is not hidden and every texel of the 2x2 footprint of its bilinear colour
+  // sample shows the vertex's own surface; kFootprintPartial | mask when it is not hidden but the
+  // footprint straddles a depth jump (silhouette, mesh border, contact with another surface):
+  // `mask` (footprint_texel_bit) marks the texels that still show the vertex's own surface, 0 when
+  // none does. A texel is "own surface" when the first surface along its pixel ray lies within
+  // own_surface_depth_slack of the vertex's depth. Vertices outside the image or behind the camera
+  // get kCameraClear (not this pass's concern). Both back ends implement the footprint test (GL
+  // from its depth map, the CPU by casting the 4 texel rays).
+  virtual void camera_pass(const Shot &shot, uint8_t *out) = 0;
+  // out[v] = 1 when no geometry lies between vertex v and the light, else 0 (cast shadow). A
+  // directional light shines from `light.direction` (an orthographic shadow map over the mesh; CPU:
+  // rays along it); a point light from `light.position` (a perspective shadow map from there,
+  // fitted to the mesh's bounding sphere; CPU: rays towards the position, stopping there).
+  virtual void light_pass(const LightSource &light, uint8_t *out) = 0;
+};
+
+// CPU reference: rays from each vertex (offset along the ray by the tolerance) against a
+// vcglib uniform grid over the triangles. Exact but slow; OpenMP-parallel.
+std::unique_ptr<VisibilityBackend> make_cpu_visibility(const MeshView &mesh, const VisibilitySettings &settings);
+
+} // namespace vbrdf
