@@ -258,6 +258,12 @@ def break_project(case, proj_dir, mlp, lp):
             return v, f
         edit_mesh(mesh, zero_all)
         return ["no per-vertex normals", "Re-Compute Vertex Normals"]
+    if case == "lp_flipped":  # one photo's light direction reversed: it contradicts the photo
+        entries = read_lp(lp)
+        name, d = entries[1]
+        entries[1] = (name, [repr(-float(c)) for c in d])
+        write_lp(lp, entries)
+        return [os.path.basename(lp), "disagrees with photo", os.path.basename(name)]
     if case == "light_inside":  # a light-position file whose first light sits inside the object
         ply = lib.read_ply(mesh)
         centre = [float((ply.vertex[c].min() + ply.vertex[c].max()) / 2) for c in "xyz"]

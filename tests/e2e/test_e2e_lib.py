@@ -127,7 +127,8 @@ class ScriptTest(unittest.TestCase):
         self.assertEqual(root.tag, "FilterScript")
         params = {p.get("name"): p for p in root.find("filter").iter("Param")}
         self.assertEqual(root.find("filter").get("name"), "Vertex BRDF: fit per-vertex reflectance")
-        types = {"lightFile": "RichOpenFile", "outputPly": "RichSaveFile", "specularThreshold": "RichFloat",
+        types = {"lightFile": "RichOpenFile", "domeRadius": "RichFloat", "lightUnitScale": "RichFloat",
+                 "outputPly": "RichSaveFile", "specularThreshold": "RichFloat",
                  "diffuseThreshold": "RichFloat", "photoEncoding": "RichEnum", "saturationLevel": "RichFloat",
                  "visibilityBackend": "RichEnum", "depthTolerance": "RichFloat", "shadowMapSize": "RichInt",
                  "memoryBudgetMB": "RichInt", "fitReflectance": "RichBool", "fitBackend": "RichEnum",

@@ -8,6 +8,7 @@
 
 #include "base/errors.h"
 #include "inputs/light_source.h"
+#include "samples/light_check.h"
 #include "samples/samples.h"
 #include "test_paths.h"
 #include "test_scenes.h"
@@ -188,6 +189,55 @@ TEST(LightSource, SamplesAreDividedByTheFallOff) {
   EXPECT_FLOAT_EQ(chunk.samples[0].rgb[0], 0.5f);  // vertex 0 at the reference distance
   EXPECT_FLOAT_EQ(chunk.samples[1].rgb[0], 0.5f);  // directional
   EXPECT_FLOAT_EQ(chunk.samples[2].rgb[0], 2.0f);  // vertex 1 twice as far: a quarter of the light
+}
+
+// A light on the wrong side of the object (its brightest predicted vertices are the dark ones in
+// the photo) is refused by name; a right light, and a photo with too few samples to tell, pass.
+TEST(LightSource, ALightThatContradictsItsPhotoIsRefused) {
+  const Capture s;
+  std::vector<float> positions, normals;
+  const size_t n = 400;
+  for (size_t v = 0; v < n; ++v) {
+    const float a = float(v) / float(n) * 6.2831853f;
+    positions.insert(positions.end(), {std::cos(a), std::sin(a), 0});
+    normals.insert(normals.end(), {std::cos(a), std::sin(a), 0});
+  }
+  MeshView mesh;
+  mesh.positions = positions.data();
+  mesh.normals = normals.data();
+  mesh.vertex_count = n;
+  const std::vector<LightSource> lights = {LightSource::directional({{1, 0, 0}}), LightSource::directional({{-1, 0, 0}})};
+  // Both photos are lit from +x (brightness = max(n.x, 0) times a varying albedo); raster 1's
+  // light file entry says -x.
+  SampleChunk chunk;
+  chunk.first_vertex = 0;
+  chunk.vertex_count = uint32_t(n);
+  chunk.offsets.push_back(0);
+  for (size_t v = 0; v < n; ++v) {
+    const float albedo = 0.3f + 0.4f * float((v * 7) % 10) / 10.0f;
+    const float lit = std::max(0.0f, normals[3 * v]) * albedo;
+    for (uint16_t r = 0; r < 2; ++r) {
+      const float d = normals[3 * v] * lights[r].direction[0];
+      chunk.samples.push_back(Sample{{lit, lit, lit}, d, 0, r, uint16_t(d <= 0 ? kAttachedShadow : 0)});
+    }
+    chunk.offsets.push_back(uint32_t(chunk.samples.size()));
+  }
+  LightAgreement agreement(2);
+  agreement.add(chunk, mesh, lights);
+  EXPECT_GT(agreement.correlation(0), 0.5);
+  EXPECT_LT(agreement.correlation(1), -0.3);
+  try {
+    check_light_agreement(agreement, s.rasters, "lights.lp");
+    ADD_FAILURE() << "a contradicting light was accepted";
+  } catch (const InputError &e) {
+    EXPECT_NE(std::string(e.what()).find("'b.png'"), std::string::npos) << e.what();
+  }
+  LightAgreement few(2);
+  SampleChunk small = chunk;
+  small.vertex_count = 40;  // 40 samples per photo: too few to judge
+  small.offsets.resize(41);
+  few.add(small, mesh, lights);
+  EXPECT_NO_THROW(check_light_agreement(few, s.rasters, "lights.lp"));
 }
 
 } // namespace

@@ -11,6 +11,7 @@
 #include "inputs/light_file.h"
 #include "calibration/color_plan.h"
 #include "inputs/light_source.h"
+#include "samples/light_check.h"
 #include "io/output_ply.h"
 #include "fit/phong_fit_gpu.h"
 #include "io/result_schema.h"
@@ -253,6 +254,8 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   rep << "filter_vertex_brdf report\n"
       << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
+      << "lights against the photos (predicted irradiance vs brightness): "
+      << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
       << "visibility back end: " << r.visibility_backend << "\n"
       << color_report(r, settings)
       << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
@@ -405,16 +408,20 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
   if (settings.fit_reflectance) result.fits.resize(mesh.vertex_count);
+  LightAgreement agreement(input.rasters.size());  // a light file that contradicts the photos fails below
   const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
   result.gather = gather_samples(
       mesh, input.rasters, lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
         if (correct) correct_samples(colors, chunk);
+        agreement.add(chunk, mesh, lights);
         apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
         consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
       },
       gather_progress);
   result.seconds_gather = seconds_since(t);
+  result.light_agreement = weakest_light_agreement(agreement, input.rasters);
+  check_light_agreement(agreement, input.rasters, result.light_file);  // before anything is written
   result.colors = std::move(colors.viewpoints);
   if (settings.fit_reflectance) fill_gaps(input, settings, log, result);
 

@@ -91,6 +91,7 @@ struct FitResult {
   double seconds_fit = 0;
   std::string light_file;                 // the light file used (.lp, .json or .dome)
   std::string light_model;                // describe_lights: directional / point lights and their distances
+  std::string light_agreement;            // the photo whose light agrees least with it (samples/light_check.h)
   std::vector<ColorCalibration> colors;   // per viewpoint (rasters_by_viewpoint order); empty when Off
   size_t color_viewpoints_corrected = 0;
   std::string output_ply;                 // where the PLY was written
