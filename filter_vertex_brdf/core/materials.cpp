@@ -81,7 +81,7 @@ inline double lobe_of(float log_s, double alpha) {
 std::vector<Static> static_sums(const Context &c, int set) {
   std::vector<Static> out(c.n);
   const auto &E = c.store.entries();
-#pragma omp parallel for schedule(dynamic, 512)
+#pragma omp parallel for schedule(dynamic, 512) if (c.store.entries().size() > 200000)
   for (long long v = 0; v < (long long)c.n; ++v) {
     if (!c.eligible[size_t(v)]) continue;
     Static &S = out[size_t(v)];
@@ -101,7 +101,7 @@ std::vector<Static> static_sums(const Context &c, int set) {
 std::vector<Lobe> lobe_sums(const Context &c, int set, const std::vector<int32_t> &label, const std::vector<double> &alpha_of) {
   std::vector<Lobe> out(c.n);
   const auto &E = c.store.entries();
-#pragma omp parallel for schedule(dynamic, 512)
+#pragma omp parallel for schedule(dynamic, 512) if (c.store.entries().size() > 200000)
   for (long long v = 0; v < (long long)c.n; ++v) {
     if (!c.eligible[size_t(v)] || label[size_t(v)] <= 0) continue;
     const double alpha = alpha_of[size_t(label[size_t(v)])];
@@ -351,40 +351,104 @@ std::vector<int32_t> initial_labels(const Context &c, const std::vector<Static> 
   return label;
 }
 
-// Per-vertex parameters of a labelling: regularised k_s, alpha of the material, rho re-solved.
+// Per-vertex parameters of a labelling, for one choice of priors: alpha = the material's alpha times
+// 2^(k/4), k in [-8, 8] (only k = 0 when alpha_prior < 0), with a quadratic prior on ln alpha of
+// weight alpha_prior x (the material's mean k_s information x k_s^2); k_s regularised towards the
+// material's with weight prior x the mean information; rho re-solved exactly.
+struct Choice {
+  float prior;        // k_s prior strength
+  float alpha_prior;  // < 0: the material's alpha only
+};
+constexpr int kAlphaSteps = 17, kAlphaCentre = 8;
+
 struct Params {
-  std::vector<double> ks, rho;  // rho: 3 per vertex
+  std::vector<double> ks, rho, alpha;  // rho: 3 per vertex
 };
 
-Params vertex_params(const Context &c, const std::vector<Static> &S, const std::vector<Lobe> &L,
-                     const std::vector<int32_t> &label, const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse,
-                     int K, double prior) {
+// For every choice, the error of its parameters (fitted on `fit_set`) at `score_set` (summed over
+// the vertices), and, when `params` is given, the parameters of choice 0.
+std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &S_fit, const std::vector<Static> &S_score,
+                                   int fit_set, int score_set, const std::vector<int32_t> &label,
+                                   const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse, int K,
+                                   const std::vector<Choice> &choices, Params *params) {
+  // The material's mean k_s information at its alpha: the scale of both priors.
+  std::vector<double> alpha_of(size_t(K) + 1, 1.0);
+  for (int m = 1; m <= K; ++m) alpha_of[size_t(m)] = lobes[size_t(m)].alpha;
+  const std::vector<Lobe> L0 = lobe_sums(c, fit_set, label, alpha_of);
   std::vector<double> mean_info(size_t(K) + 1, 0), cnt(size_t(K) + 1, 0);
   for (size_t v = 0; v < c.n; ++v) {
     if (!c.eligible[v] || label[v] <= 0) continue;
     double info, rhs;
-    ks_equation(S[v], L[v], info, rhs);
+    ks_equation(S_fit[v], L0[v], info, rhs);
     if (info > 0) mean_info[size_t(label[v])] += info, cnt[size_t(label[v])] += 1;
   }
   for (int m = 1; m <= K; ++m) mean_info[size_t(m)] = cnt[size_t(m)] > 0 ? mean_info[size_t(m)] / cnt[size_t(m)] : 0;
-  Params P;
-  P.ks.assign(c.n, 0);
-  P.rho.assign(3 * c.n, 0);
-  for (size_t v = 0; v < c.n; ++v) {
+  const size_t nc = choices.size();
+  std::vector<double> score(c.n * nc, 0.0);
+  if (params) params->ks.assign(c.n, 0), params->rho.assign(3 * c.n, 0), params->alpha.assign(c.n, 0);
+  const auto &E = c.store.entries();
+#pragma omp parallel for schedule(dynamic, 256) if (c.store.entries().size() > 200000)
+  for (long long vi = 0; vi < (long long)c.n; ++vi) {
+    const size_t v = size_t(vi);
     if (!c.eligible[v] || label[v] <= 0) continue;
     const size_t m = size_t(label[v]);
-    double ks = 0;
-    if (!diffuse[m]) {
-      double info, rhs;
-      ks_equation(S[v], L[v], info, rhs);
-      const double lambda = prior * mean_info[m];
-      ks = info + lambda > 0 ? (rhs + lambda * lobes[m].ks) / (info + lambda) : lobes[m].ks;
-      ks = std::min(std::max(ks, 0.0), double(c.o.ks_max));
+    if (diffuse[m]) {
+      double rho[3];
+      energy_ks(S_fit[v], Lobe(), 0, rho);
+      const double e = energy_fixed(S_score[v], Lobe(), 0, rho);
+      for (size_t ch = 0; ch < nc; ++ch) score[v * nc + ch] = e;
+      if (params) std::copy(rho, rho + 3, &params->rho[3 * v]);
+      continue;
     }
-    P.ks[v] = ks;
-    energy_ks(S[v], diffuse[m] ? Lobe() : L[v], ks, &P.rho[3 * v]);
+    Lobe Lf[kAlphaSteps], Ls[kAlphaSteps];
+    double alpha[kAlphaSteps];
+    for (int k = 0; k < kAlphaSteps; ++k)
+      alpha[k] = std::min(std::max(lobes[m].alpha * std::pow(2.0, (k - kAlphaCentre) / 4.0), double(c.o.alpha_min)),
+                          double(c.o.alpha_max));
+    for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
+      const Entry &e = E[i];
+      const bool f = c.in_set(e, fit_set), sc = c.in_set(e, score_set);
+      if ((!f && !sc) || c.log_s[i] > 0) continue;
+      for (int k = 0; k < kAlphaSteps; ++k) {
+        const double g = lobe_of(c.log_s[i], alpha[k]);
+        if (g == 0) continue;
+        for (Lobe *L : {f ? &Lf[k] : nullptr, sc ? &Ls[k] : nullptr}) {
+          if (!L) continue;
+          L->b += double(e.w) * e.d * g, L->g2 += double(e.w) * g * g;
+          for (int ch = 0; ch < 3; ++ch) L->q[ch] += double(e.w) * g * e.rgb[ch];
+        }
+      }
+    }
+    for (size_t ch = 0; ch < nc; ++ch) {
+      const double lambda = choices[ch].prior * mean_info[m];
+      const double mu = choices[ch].alpha_prior * mean_info[m] * lobes[m].ks * lobes[m].ks;
+      int best_k = kAlphaCentre;
+      double best_obj = 1e300, best_ks = 0;
+      for (int k = 0; k < kAlphaSteps; ++k) {
+        if (choices[ch].alpha_prior < 0 && k != kAlphaCentre) continue;
+        double info, rhs;
+        ks_equation(S_fit[v], Lf[k], info, rhs);
+        double ks = info + lambda > 0 ? (rhs + lambda * lobes[m].ks) / (info + lambda) : lobes[m].ks;
+        ks = std::min(std::max(ks, 0.0), double(c.o.ks_max));
+        const double t = std::log(alpha[k] / lobes[m].alpha);
+        const double obj = energy_ks(S_fit[v], Lf[k], ks) + lambda * (ks - lobes[m].ks) * (ks - lobes[m].ks) +
+                           std::max(0.0, double(mu)) * t * t;
+        if (obj < best_obj) best_obj = obj, best_k = k, best_ks = ks;
+      }
+      double rho[3];
+      energy_ks(S_fit[v], Lf[best_k], best_ks, rho);
+      score[v * nc + ch] = energy_fixed(S_score[v], Ls[best_k], best_ks, rho);
+      if (params && ch == 0) {
+        params->ks[v] = best_ks, params->alpha[v] = alpha[best_k];
+        std::copy(rho, rho + 3, &params->rho[3 * v]);
+      }
+    }
   }
-  return P;
+  std::vector<double> total(nc, 0.0);
+  for (size_t v = 0; v < c.n; ++v)
+    if (S_fit[v].n > 0)
+      for (size_t ch = 0; ch < nc; ++ch) total[ch] += score[v * nc + ch];
+  return total;
 }
 
 std::vector<uint8_t> diffuse_flags(const std::vector<LobeFit> &lobes, const std::vector<double> &median_kd, int K,
@@ -469,44 +533,41 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   for (size_t v = 0; v < c.n; ++v) ones[v] = c.eligible[v] ? 1 : 0;
   const std::vector<LobeFit> one = fit_lobes(c, kTrain, S_train, ones, 1);
   std::vector<Config> configs;
-  std::vector<float> best_prior;
+  std::vector<Choice> best_choice, choices;
+  for (float prior : mo.prior_strengths)
+    for (float alpha_prior : mo.alpha_prior_strengths) choices.push_back({prior, alpha_prior});
+  if (choices.empty()) choices.push_back({1.0f, -1.0f});
   const int kmax = std::max(1, mo.max_materials);
   for (int K = 1; K <= kmax; ++K) {
     Config cfg = K == 1 ? Config{1, ones, one} : cluster(c, adj, S_train, kTrain, initial_labels(c, S_train, kTrain, one[1].alpha, K), K, mo.iterations);
     if (cfg.K < K && K > 1) {  // collapsed to fewer materials: nothing new to score
       R.heldout_error.push_back(R.heldout_error.empty() ? 0 : R.heldout_error.back());
       configs.push_back(cfg);
-      best_prior.push_back(best_prior.empty() ? 1.0f : best_prior.back());
+      best_choice.push_back(best_choice.empty() ? choices.front() : best_choice.back());
       continue;
     }
-    std::vector<double> alpha_of(size_t(cfg.K) + 1, 1.0);
-    for (int m = 1; m <= cfg.K; ++m) alpha_of[size_t(m)] = cfg.lobes[size_t(m)].alpha;
-    const std::vector<Lobe> L_train = lobe_sums(c, kTrain, cfg.label, alpha_of), L_held = lobe_sums(c, kHeld, cfg.label, alpha_of);
     const std::vector<uint8_t> diffuse = diffuse_flags(cfg.lobes, median_kd_of(c, fits, cfg.label, cfg.K), cfg.K, mo);
-    double best = 1e300;
-    float prior_best = mo.prior_strengths.empty() ? 1.0f : mo.prior_strengths.front();
-    for (float prior : mo.prior_strengths) {
-      const Params P = vertex_params(c, S_train, L_train, cfg.label, cfg.lobes, diffuse, cfg.K, prior);
-      double e = 0;
-      for (size_t v = 0; v < c.n; ++v)
-        if (c.eligible[v] && cfg.label[v] > 0 && S_train[v].n > 0)
-          e += energy_fixed(S_held[v], diffuse[size_t(cfg.label[v])] ? Lobe() : L_held[v], P.ks[v], &P.rho[3 * v]);
-      if (e < best) best = e, prior_best = prior;
-    }
+    const std::vector<double> err = solve_vertices(c, S_train, S_held, kTrain, kHeld, cfg.label, cfg.lobes, diffuse, cfg.K, choices, nullptr);
+    const size_t b = size_t(std::min_element(err.begin(), err.end()) - err.begin());
+    const double best = err[b];
+    const Choice choice_best = choices[b];
     R.heldout_error.push_back(best);
     configs.push_back(std::move(cfg));
-    best_prior.push_back(prior_best);
+    best_choice.push_back(choice_best);
   }
   const double best_error = *std::min_element(R.heldout_error.begin(), R.heldout_error.end());
   size_t chosen = 0;
   while (chosen + 1 < R.heldout_error.size() && R.heldout_error[chosen] > (1 + mo.choose_tolerance) * best_error) ++chosen;
-  R.chosen_prior = best_prior[chosen];
+  R.chosen_prior = best_choice[chosen].prior;
+  R.chosen_alpha_prior = best_choice[chosen].alpha_prior;
   rep << "materials (issue 16): chosen by held-out error (every " << mo.heldout_every << "th photo left out, fitted on the "
       << "others): ";
   for (size_t k = 0; k < R.heldout_error.size(); ++k)
     rep << (k ? ", " : "") << "K=" << k + 1 << " " << fixed(R.heldout_error[k] / std::max(best_error, 1e-300), 4);
   rep << " (relative to the best); smallest K within " << fixed(100 * mo.choose_tolerance, 1) << " % of the best: "
-      << configs[chosen].K << "; k_s prior strength " << R.chosen_prior << "\n";
+      << configs[chosen].K << "; k_s prior strength " << R.chosen_prior << ", per-vertex alpha "
+      << (R.chosen_alpha_prior < 0 ? std::string("= the material's") : "prior strength " + fixed(R.chosen_alpha_prior, 3))
+      << "\n";
 
   // 2. Refit the chosen configuration on all samples.
   const std::vector<Static> S = static_sums(c, kAll);
@@ -518,7 +579,8 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   const std::vector<Lobe> L = lobe_sums(c, kAll, fin.label, alpha_of);
   const std::vector<double> median_kd = median_kd_of(c, fits, fin.label, K);
   const std::vector<uint8_t> diffuse = diffuse_flags(fin.lobes, median_kd, K, mo);
-  const Params P = vertex_params(c, S, L, fin.label, fin.lobes, diffuse, K, R.chosen_prior);
+  Params P;
+  solve_vertices(c, S, S, kAll, kAll, fin.label, fin.lobes, diffuse, K, {best_choice[chosen]}, &P);
 
   // 3. Write the fits.
   R.materials.resize(size_t(K));
@@ -548,7 +610,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
         for (int ch = 0; ch < 3; ++ch) f.color[ch] = kd > 0 ? float(std::min(1.0, rho[ch] / kd)) : 0.0f;
       }
       f.ks = diffuse[m] ? 0.0f : float(P.ks[v]);
-      f.shininess = f.ks > 0 ? float(fin.lobes[m].alpha) : 0.0f;
+      f.shininess = f.ks > 0 ? float(P.alpha[v]) : 0.0f;
       if (!weak) f.status = f.ks > 0 ? kFitFull : kFitDiffuseOnly;
       recompute_fit_quality(samples.data(), samples.size(), o, weak, f);
     }

@@ -46,7 +46,10 @@ struct MaterialOptions {
   int heldout_every = 4;             // photos with index % heldout_every == heldout_every - 1 are held out
   float choose_tolerance = 0.005f;   // relative held-out error within which a smaller K is preferred
   float diffuse_ks_fraction = 0.01f; // pooled k_s below this fraction of the median k_d: diffuse material
-  std::vector<float> prior_strengths = {0.25f, 1.0f, 4.0f};  // candidates, chosen by held-out error
+  std::vector<float> prior_strengths = {0.0f, 0.25f, 1.0f, 4.0f};  // k_s prior candidates, chosen by held-out error
+  // Per-vertex alpha: candidates for the strength of its prior towards the material's alpha
+  // (< 0: the material's alpha itself), chosen by held-out error with the k_s prior.
+  std::vector<float> alpha_prior_strengths = {-1.0f, 0.0f, 0.1f, 1.0f};
   float coherence = 1.0f;            // ICM cost per disagreeing neighbour (log-likelihood units)
   int iterations = 4;                // lobe fit / assignment alternations
 };
@@ -68,6 +71,7 @@ struct MaterialResult {
   std::vector<double> heldout_error;   // per K tried (K = index + 1), sum of weighted squared residuals
   int chosen_k = 0;
   float chosen_prior = 0;
+  float chosen_alpha_prior = -1;       // < 0: every vertex has its material's alpha
   uint64_t vertices_changed_to_specular = 0;  // diffuse-only before, a lobe now
   uint64_t vertices_set_diffuse = 0;           // had k_s > 0, now in a diffuse material
   size_t bytes_kept = 0;

@@ -304,9 +304,7 @@ void run_material_stage(const FitInput &input, const FitSettings &settings, cons
     valid[v] = e.valid && !e.from_mixed_pixels;
     for (int c = 0; c < 3; ++c) rgb[3 * v + size_t(c)] = e.rgb[c];
   }
-  const auto t = Clock::now();
   r.materials = fit_materials(input.mesh, store, settings.phong, settings.material_options, rgb.data(), valid.data(), r.fits);
-  r.seconds_fit += seconds_since(t);
   std::istringstream lines(r.materials.report);
   for (std::string line; std::getline(lines, line);) log(line);
 }
