@@ -241,6 +241,41 @@ double median_of(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// Vertices without a label take the most common label among their labelled neighbours, ring by
+// ring through the whole mesh (vertices outside the stage pass labels on); an eligible vertex that
+// no label reaches takes its data's best label.
+void spread_labels(const Context &c, const Adjacency &adj, const std::vector<std::vector<double>> &cost, int K,
+                   std::vector<int32_t> &label) {
+  const size_t n = adj.start.size() - 1;
+  std::vector<int32_t> lab(n, 0);
+  for (size_t v = 0; v < std::min(n, c.n); ++v) lab[v] = c.eligible[v] ? label[v] : 0;
+  std::vector<int> count(size_t(K) + 1);
+  for (bool grew = true; grew;) {
+    grew = false;
+    std::vector<int32_t> next = lab;
+    for (size_t v = 0; v < n; ++v) {
+      if (lab[v] > 0) continue;
+      std::fill(count.begin(), count.end(), 0);
+      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k)
+        if (lab[adj.list[k]] > 0) ++count[size_t(lab[adj.list[k]])];
+      const int best = int(std::max_element(count.begin() + 1, count.end()) - count.begin());
+      if (count[size_t(best)] > 0) next[v] = best, grew = true;
+    }
+    lab.swap(next);
+  }
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v]) continue;
+    if (v < n && lab[v] > 0) {
+      label[v] = lab[v];
+      continue;
+    }
+    int best = 1;
+    for (int m = 2; m <= K; ++m)
+      if (cost[size_t(m)][v] < cost[size_t(best)][v]) best = m;
+    label[v] = best;
+  }
+}
+
 // Labels by the data (energy under each lobe over the residual variance) and the neighbours (ICM).
 void assign_labels(const Context &c, const Adjacency &adj, const std::vector<Static> &S, int set,
                    const std::vector<LobeFit> &lobes, int K, std::vector<int32_t> &label) {
@@ -267,11 +302,19 @@ void assign_labels(const Context &c, const Adjacency &adj, const std::vector<Sta
     const double var_v = S[v].n > 4 ? std::max(emin[v] / double(3 * S[v].n - 4), floor_var) : floor_var;
     for (int m = 1; m <= K; ++m) cost[size_t(m)][v] = (cost[size_t(m)][v] - emin[v]) / (2 * var_v);
   }
+  // Only vertices with a highlight sample (R.E > T_s) decide by their data: for the others the
+  // lobes differ only in their flanks, where the R.E form is least faithful. ICM among the deciding
+  // vertices, then the others take the label of the nearest deciding vertices over the mesh.
+  std::vector<uint8_t> decides(c.n, 0);
+  for (size_t v = 0; v < c.n; ++v) {
+    decides[v] = c.eligible[v] && S[v].n_high > 0;
+    if (!decides[v]) label[v] = 0;
+  }
   std::vector<int> count(size_t(K) + 1);
   for (int sweep = 0; sweep < 20; ++sweep) {
     size_t changed = 0;
     for (size_t v = 0; v < c.n; ++v) {
-      if (!c.eligible[v]) continue;
+      if (!decides[v]) continue;
       std::fill(count.begin(), count.end(), 0);
       int labelled = 0;
       for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k) {
@@ -288,6 +331,7 @@ void assign_labels(const Context &c, const Adjacency &adj, const std::vector<Sta
     }
     if (!changed) break;
   }
+  spread_labels(c, adj, cost, K, label);
 }
 
 // Drops empty materials and renumbers 1..K'; returns K'.
@@ -304,7 +348,8 @@ int compact_labels(const Context &c, int K, std::vector<int32_t> &label) {
 }
 
 // Initial labels for K materials: weighted 1-D k-means of the per-vertex k_s at the pooled alpha.
-std::vector<int32_t> initial_labels(const Context &c, const std::vector<Static> &S, int set, double alpha, int K) {
+std::vector<int32_t> initial_labels(const Context &c, const Adjacency &adj, const std::vector<Static> &S, int set,
+                                    double alpha, int K) {
   std::vector<int32_t> label(c.n, 0), ones(c.n, 0);
   for (size_t v = 0; v < c.n; ++v) ones[v] = c.eligible[v] ? 1 : 0;
   const std::vector<Lobe> L = lobe_sums(c, set, ones, std::vector<double>(2, alpha));
@@ -320,9 +365,10 @@ std::vector<int32_t> initial_labels(const Context &c, const std::vector<Static> 
   const double min_info = 0.01 * median_of(infos);
   std::vector<size_t> order;
   for (size_t v = 0; v < c.n; ++v)
-    if (c.eligible[v] && w[v] > min_info) order.push_back(v);
+    if (c.eligible[v] && w[v] > min_info && S[v].n_high > 0) order.push_back(v);
   for (size_t v = 0; v < c.n; ++v) label[v] = c.eligible[v] ? 1 : 0;
   if (K <= 1 || order.empty()) return label;
+  for (size_t v = 0; v < c.n; ++v) label[v] = 0;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return ks[a] < ks[b]; });
   double total = 0;
   for (size_t v : order) total += w[v];
@@ -348,6 +394,7 @@ std::vector<int32_t> initial_labels(const Context &c, const std::vector<Static> 
       if (sw[size_t(m)] > 0) centre[size_t(m)] = swx[size_t(m)] / sw[size_t(m)];
   }
   for (size_t v : order) label[v] = assign[v] + 1;
+  spread_labels(c, adj, std::vector<std::vector<double>>(size_t(K) + 1, std::vector<double>(c.n, 0.0)), K, label);
   return label;
 }
 
@@ -454,7 +501,8 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
 std::vector<uint8_t> diffuse_flags(const std::vector<LobeFit> &lobes, const std::vector<double> &median_kd, int K,
                                    const MaterialOptions &mo) {
   std::vector<uint8_t> d(size_t(K) + 1, 0);
-  for (int m = 1; m <= K; ++m) d[size_t(m)] = lobes[size_t(m)].ks <= mo.diffuse_ks_fraction * median_kd[size_t(m)];
+  for (int m = 1; m <= K; ++m)
+    d[size_t(m)] = lobes[size_t(m)].ks <= mo.diffuse_ks_fraction * median_kd[size_t(m)] || lobes[size_t(m)].alpha <= mo.min_lobe_alpha;
   return d;
 }
 
@@ -539,7 +587,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   if (choices.empty()) choices.push_back({1.0f, -1.0f});
   const int kmax = std::max(1, mo.max_materials);
   for (int K = 1; K <= kmax; ++K) {
-    Config cfg = K == 1 ? Config{1, ones, one} : cluster(c, adj, S_train, kTrain, initial_labels(c, S_train, kTrain, one[1].alpha, K), K, mo.iterations);
+    Config cfg = K == 1 ? Config{1, ones, one} : cluster(c, adj, S_train, kTrain, initial_labels(c, adj, S_train, kTrain, one[1].alpha, K), K, mo.iterations);
     if (cfg.K < K && K > 1) {  // collapsed to fewer materials: nothing new to score
       R.heldout_error.push_back(R.heldout_error.empty() ? 0 : R.heldout_error.back());
       configs.push_back(cfg);
@@ -597,6 +645,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     VertexFit &f = fits[v];
     const bool had_ks = f.ks > 0;
     const bool weak = f.status == kFitFromWeakSamples;
+    if (mo.keep_full_fits && !diffuse[m] && f.status == kFitFull && f.ks > 0) continue;
     const std::vector<Sample> samples = store.as_samples(v);
     if (diffuse[m] && diffuse_rgb && diffuse_valid && diffuse_valid[v] && !weak) {
       set_diffuse_only_reflectance(samples.data(), samples.size(), o, diffuse_rgb + 3 * v, f);
@@ -633,8 +682,8 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
         << "), the lobe lowers the pooled energy by " << fixed(100 * mat.lobe_gain, 2) << " %; median k_d "
         << fixed(mat.median_kd, 4);
     if (mat.diffuse)
-      rep << "; DIFFUSE (k_s below " << fixed(100 * mo.diffuse_ks_fraction, 1)
-          << " % of k_d): k_s = 0, specular stages skipped for its vertices";
+      rep << "; DIFFUSE (k_s below " << fixed(100 * mo.diffuse_ks_fraction, 1) << " % of k_d, or alpha <= " << fixed(mo.min_lobe_alpha, 1)
+          << "): k_s = 0, specular stages skipped for its vertices";
     rep << "\n";
   }
   R.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -52,6 +52,13 @@ struct MaterialOptions {
   std::vector<float> alpha_prior_strengths = {-1.0f, 0.0f, 0.1f, 1.0f};
   float coherence = 1.0f;            // ICM cost per disagreeing neighbour (log-likelihood units)
   int iterations = 4;                // lobe fit / assignment alternations
+  // true: vertices whose own fit has a lobe (fit_status 2, k_s > 0) keep it; only the others (the
+  // per-vertex rule left them diffuse-only, or weak) take the material's lobe. false: every vertex
+  // of a glossy material gets the material-regularised k_s and alpha.
+  bool keep_full_fits = false;
+  // A pooled lobe with alpha at or below this is no highlight (R.E^alpha with alpha ~ 1 is a broad
+  // cosine that only absorbs shading-model misfit): the material is treated as diffuse.
+  float min_lobe_alpha = 2.0f;
 };
 
 struct Material {

@@ -52,6 +52,7 @@ int main(int argc, char **argv) {
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
     else if (a == "--photo-dir") photo_dir = next();
     else if (a == "--materials") settings.materials = next() == "on";
+    else if (a == "--keep-full-fits") settings.material_options.keep_full_fits = true;
     else if (a == "--max-materials") settings.material_options.max_materials = std::stoi(next());
     else if (a == "--color-correction") {
       const std::string v = next();

@@ -106,7 +106,9 @@ TEST(Materials, TwoMaterialsAndTheirLobesAreRecovered) {
   for (size_t v = 0; v < sc.truth.size(); ++v) {
     if (r.result.label[v] == glossy) {
       ++glossy_n, glossy_ks += r.after[v].ks > 0, glossy_ks_before += r.before[v].ks > 0;
-      EXPECT_FLOAT_EQ(r.after[v].shininess, r.after[v].ks > 0 ? float(g.shininess) : 0.0f);
+      // The vertex's alpha is its material's, or regularised towards it within a factor of 4.
+      EXPECT_GE(r.after[v].shininess, 0.25f * float(g.shininess) * 0.999f);
+      EXPECT_LE(r.after[v].shininess, 4.0f * float(g.shininess) * 1.001f);
     } else {
       ++diffuse_n, diffuse_ks0 += r.after[v].ks == 0;
     }
