@@ -515,6 +515,39 @@ std::vector<double> median_kd_of(const Context &c, const std::vector<VertexFit> 
   return out;
 }
 
+// One robust pass on k_d C with the lobe fixed (as the basic colour's, diffuse_color.h): samples
+// whose residual exceeds 3 scaled MADs (shadow edges the depth passes miss) are dropped and rho is
+// re-solved from the rest; unchanged when fewer than 4 samples remain.
+void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[3]) {
+  const auto &E = c.store.entries();
+  std::vector<double> res;
+  for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
+    const Entry &e = E[i];
+    const double g = ks > 0 ? ks * lobe_of(c.log_s[i], alpha) : 0.0;
+    double r = 0;
+    for (int ch = 0; ch < 3; ++ch) r += std::fabs(e.rgb[ch] - rho[ch] * e.d - g);
+    res.push_back(r / 3);
+  }
+  if (res.size() < 6) return;
+  std::vector<double> sorted = res;
+  const double med = median_of(sorted);
+  for (double &x : sorted) x = std::fabs(x - med);
+  const double mad = 1.4826 * median_of(sorted);
+  if (!(mad > 0)) return;
+  double a = 0, p[3] = {0, 0, 0};
+  size_t kept = 0;
+  for (uint64_t i = c.store.first(v), j = 0; i < c.store.last(v); ++i, ++j) {
+    if (std::fabs(res[j] - med) > 3 * mad) continue;
+    const Entry &e = E[i];
+    const double g = ks > 0 ? ks * lobe_of(c.log_s[i], alpha) : 0.0;
+    a += double(e.w) * e.d * e.d;
+    for (int ch = 0; ch < 3; ++ch) p[ch] += double(e.w) * e.d * (e.rgb[ch] - g);
+    ++kept;
+  }
+  if (kept < 4 || !(a > 0)) return;
+  for (int ch = 0; ch < 3; ++ch) rho[ch] = std::max(0.0, p[ch] / a);
+}
+
 struct Config {
   int K = 0;
   std::vector<int32_t> label;
@@ -650,7 +683,8 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     if (diffuse[m] && diffuse_rgb && diffuse_valid && diffuse_valid[v] && !weak) {
       set_diffuse_only_reflectance(samples.data(), samples.size(), o, diffuse_rgb + 3 * v, f);
     } else {
-      const double *rho = &P.rho[3 * v];
+      double rho[3] = {P.rho[3 * v], P.rho[3 * v + 1], P.rho[3 * v + 2]};
+      if (mo.robust_colour) robust_rho(c, v, diffuse[m] ? 0.0 : P.ks[v], P.alpha[v], rho);
       const double kd = std::max(rho[0], std::max(rho[1], rho[2]));
       if (!(S[v].a > 0) && !diffuse[m]) {
         // No diffuse information (cannot happen with a usable sample, but stay safe): keep k_d C.

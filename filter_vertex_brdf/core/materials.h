@@ -55,10 +55,11 @@ struct MaterialOptions {
   // true: vertices whose own fit has a lobe (fit_status 2, k_s > 0) keep it; only the others (the
   // per-vertex rule left them diffuse-only, or weak) take the material's lobe. false: every vertex
   // of a glossy material gets the material-regularised k_s and alpha.
-  bool keep_full_fits = false;
+  bool keep_full_fits = true;
   // A pooled lobe with alpha at or below this is no highlight (R.E^alpha with alpha ~ 1 is a broad
   // cosine that only absorbs shading-model misfit): the material is treated as diffuse.
   float min_lobe_alpha = 2.0f;
+  bool robust_colour = true;         // one 3-MAD outlier pass on k_d C with the lobe fixed (final fit only)
 };
 
 struct Material {

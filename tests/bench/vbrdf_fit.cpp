@@ -28,7 +28,7 @@ int usage() {
                "                 [--encoding auto|srgb|linear] [--shadow-map N] [--fit auto|gpu|cpu|off]\n"
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
-               "                 [--materials on|off] [--max-materials N]\n";
+               "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n";
   return 2;
 }
 } // namespace
@@ -52,7 +52,8 @@ int main(int argc, char **argv) {
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
     else if (a == "--photo-dir") photo_dir = next();
     else if (a == "--materials") settings.materials = next() == "on";
-    else if (a == "--keep-full-fits") settings.material_options.keep_full_fits = true;
+    else if (a == "--material-lobes-everywhere") settings.material_options.keep_full_fits = false;
+    else if (a == "--no-robust-colour") settings.material_options.robust_colour = false;
     else if (a == "--max-materials") settings.material_options.max_materials = std::stoi(next());
     else if (a == "--color-correction") {
       const std::string v = next();
