@@ -69,7 +69,7 @@ struct StageRun {
   std::vector<VertexFit> before, after;
 };
 
-StageRun run_stage(const Scene &sc) {
+StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions()) {
   PhongFitOptions o;
   StageRun r;
   r.before.resize(sc.chunk.vertex_count);
@@ -77,7 +77,7 @@ StageRun run_stage(const Scene &sc) {
   r.after = r.before;
   MaterialSampleStore store(sc.chunk.vertex_count);
   store.add_chunk(sc.chunk, r.before.data(), o);
-  r.result = fit_materials(sc.mesh.view(), store, o, MaterialOptions(), nullptr, nullptr, r.after);
+  r.result = fit_materials(sc.mesh.view(), store, o, mo, nullptr, nullptr, r.after);
   return r;
 }
 
@@ -86,7 +86,9 @@ StageRun run_stage(const Scene &sc) {
 TEST(Materials, TwoMaterialsAndTheirLobesAreRecovered) {
   const float ks = 0.5f, alpha = 30.0f;
   const Scene sc = make_scene(true, ks, alpha, 7);
-  const StageRun r = run_stage(sc);
+  MaterialOptions everywhere;
+  everywhere.keep_full_fits = false;  // every glossy vertex takes the material-regularised lobe
+  const StageRun r = run_stage(sc, everywhere);
   ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
   ASSERT_EQ(r.result.materials.size(), 2u);
   // Which found material is the glossy one: the one holding most truly glossy vertices.
@@ -145,4 +147,27 @@ TEST(Materials, NoSamplesLeaveTheFitsAlone) {
   const MaterialResult r = fit_materials(mesh.view(), store, PhongFitOptions(), MaterialOptions(), nullptr, nullptr, fits);
   EXPECT_EQ(r.chosen_k, 0);
   for (int32_t l : r.label) EXPECT_EQ(l, 0);
+}
+
+TEST(Materials, ByDefaultOwnLobesAreKeptAndTheOthersGetTheMaterials) {
+  const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
+  const StageRun r = run_stage(sc);
+  ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
+  size_t kept = 0, given = 0;
+  for (size_t v = 0; v < sc.truth.size(); ++v) {
+    const Material &m = r.result.materials[size_t(r.result.label[v]) - 1];
+    if (m.diffuse) {
+      EXPECT_EQ(r.after[v].ks, 0.0f);
+    } else if (r.before[v].status == kFitFull && r.before[v].ks > 0) {
+      EXPECT_EQ(r.after[v].ks, r.before[v].ks);
+      EXPECT_EQ(r.after[v].shininess, r.before[v].shininess);
+      ++kept;
+    } else {
+      EXPECT_GT(r.after[v].ks, 0.0f);
+      EXPECT_NEAR(r.after[v].shininess, m.shininess, 3.0 * m.shininess);
+      ++given;
+    }
+  }
+  EXPECT_GT(kept, 0u);
+  EXPECT_GT(kept + given, sc.truth.size() / 3);
 }
