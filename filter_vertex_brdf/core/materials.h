@@ -3,20 +3,24 @@
 //
 // After the per-vertex Phong fit, the modelled vertices are grouped into a few materials by their
 // specular response, a lobe (k_s, alpha on R.E) is fitted per material from the pooled samples of
-// all its vertices, and every vertex of a glossy material gets a specular term:
+// all its vertices, and every vertex of a glossy material gets a specular term. A vertex whose own
+// fit found a lobe (fit_status 2, k_s > 0) keeps it (MaterialOptions::keep_full_fits, default);
+// every other vertex of a glossy material (or every one, keep_full_fits = false) gets
 //   alpha = its material's alpha; k_s = a per-vertex least-squares k_s regularised towards the
 //   material's k_s (a quadratic prior of weight lambda = prior_strength x the material's mean
-//   per-vertex k_s information), k_d C re-solved exactly for that lobe. A vertex with no specular
-//   evidence of its own gets the material's k_s.
-// A material whose pooled k_s is below `diffuse_ks_fraction` of its median k_d is diffuse: its
+//   per-vertex k_s information), k_d C re-solved exactly for that lobe (then one robust 3-MAD pass).
+//   A vertex with no specular evidence of its own gets the material's k_s. When the held-out error
+//   prefers it, alpha is per vertex too, within a factor 4 of the material's, with a prior on ln alpha.
+// A material whose pooled k_s is below `diffuse_ks_fraction` of its median k_d, or whose alpha is
+// at most `min_lobe_alpha`, is diffuse: its
 // vertices get k_s = 0 (their diffuse-only reflectance), and the report says so.
 //
 // Grouping: for K = 1..max_materials, labels start from a weighted 1-D k-means of the per-vertex k_s
 // (at the one-material lobe's alpha) and alternate between pooled lobe fits and assignment by the
 // per-vertex energy under each lobe (exact linear re-solve of k_d C), with mesh adjacency keeping
 // regions coherent (ICM: each neighbour with another label costs `coherence`, the data term is the
-// energy difference over the vertex's residual variance; vertices without specular evidence follow
-// their neighbours). K, and the prior strength, are chosen by held-out error: every
+// energy difference over the vertex's residual variance). Only vertices with a highlight sample
+// decide by their data; the others take the label of the nearest deciding vertices over the mesh. K, and the prior strength, are chosen by held-out error: every
 // `heldout_every`-th photo is left out, the model is fitted on the others and scored on it; the
 // smallest K whose held-out error is within `choose_tolerance` of the best wins. The chosen
 // configuration is then refitted on all samples.
