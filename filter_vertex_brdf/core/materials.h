@@ -20,7 +20,8 @@
 // per-vertex energy under each lobe (exact linear re-solve of k_d C), with mesh adjacency keeping
 // regions coherent (ICM: each neighbour with another label costs `coherence`, the data term is the
 // energy difference over the vertex's residual variance). Only vertices with a highlight sample
-// decide by their data; the others take the label of the nearest deciding vertices over the mesh. K, and the prior strength, are chosen by held-out error: every
+// decide by their data; the others take the label of the nearest deciding vertices over the mesh.
+// K, and the prior strengths, are chosen by held-out error: every
 // `heldout_every`-th photo is left out, the model is fitted on the others and scored on it; the
 // smallest K whose held-out error is within `choose_tolerance` of the best wins. The chosen
 // configuration is then refitted on all samples.
