@@ -101,6 +101,12 @@ void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, Ver
 void set_diffuse_only_reflectance(const Sample *samples, size_t count, const PhongFitOptions &options,
                                   const float rho[3], VertexFit &out);
 
+// Recomputes DQ, SQ and RMSE of `fit` from the vertex's samples with the fit's usable-sample rules
+// (weak: the fallback rules of fit_vertex_weak, and DQ/SQ halved). The material stage
+// (materials.h) calls it after it changes k_s, alpha or k_d C. Parameters are not changed.
+void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOptions &options, bool weak,
+                           VertexFit &fit);
+
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
 void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float out_rgb[3]);
 

@@ -313,6 +313,14 @@ void fit_vertex_weak(const Sample *in, size_t count, const PhongFitOptions &o, V
   out.sq *= 0.5f;
 }
 
+void recompute_fit_quality(const Sample *in, size_t count, const PhongFitOptions &o, bool weak, VertexFit &fit) {
+  std::vector<FitSample> samples;
+  double w_high, w_other;
+  usable_samples(in, count, o, samples, w_high, w_other, weak);
+  quality_metrics(samples, fit, fit);
+  if (weak) fit.dq *= 0.5f, fit.sq *= 0.5f;
+}
+
 void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out) {
 #pragma omp parallel for schedule(dynamic, 256)
   for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {

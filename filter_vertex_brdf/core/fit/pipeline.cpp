@@ -177,6 +177,23 @@ void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOption
   fit_seconds += seconds_since(t);
 }
 
+// Material stage hook (materials.h, issue 16): after the per-vertex fit of every chunk, before the
+// neighbour fill (which then copies the material-consistent parameters).
+void run_material_stage(const FitInput &input, const FitSettings &settings, const MaterialSampleStore &store,
+                        const LogFn &log, FitResult &r) {
+  const size_t n = input.mesh.vertex_count;
+  std::vector<float> rgb(3 * n, 0.0f);
+  std::vector<uint8_t> valid(n, 0);
+  for (size_t v = 0; v < n; ++v) {
+    const DiffuseEstimate &e = r.diffuse[v];
+    valid[v] = e.valid && !e.from_mixed_pixels;
+    for (int c = 0; c < 3; ++c) rgb[3 * v + size_t(c)] = e.rgb[c];
+  }
+  r.materials = fit_materials(input.mesh, store, settings.phong, settings.material_options, rgb.data(), valid.data(), r.fits);
+  std::istringstream lines(r.materials.report);
+  for (std::string line; std::getline(lines, line);) log(line);
+}
+
 // Seen vertices still without a model (every sample shadowed or saturated) and, on request, small
 // unseen gaps take the parameters of their nearest modelled neighbours (neighbour_fill.h).
 void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &log, FitResult &r) {
@@ -223,6 +240,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     const bool mixed = e.from_mixed_pixels || e.from_rim_pixels;
     const bool from_neighbours = !r.fits.empty() && r.fits[v].status == kFitFromNeighbours;
     rec.coloured = coloured ? (from_neighbours ? 3.0f : mixed ? 2.0f : 1.0f) : 0.0f;
+    if (v < r.materials.label.size()) rec.material = float(r.materials.label[v]);
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
       rec.fit = f;
@@ -290,6 +308,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
         << "  converged before the cap of " << settings.phong.max_iterations << " iterations: " << r.fit_converged
         << " of " << r.fit_full << " full fits; alpha iterations run: " << r.fit_iterations << " of at most "
         << uint64_t(r.fit_full + r.fit_diffuse_only) * uint64_t(std::max(0, settings.phong.max_iterations)) << "\n";
+    rep << (settings.materials ? r.materials.report : "materials: off (per-vertex lobes only)\n");
   } else {
     rep << "Phong fit: off (basic diffuse colour only)\n";
   }
@@ -410,6 +429,8 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   if (settings.fit_reflectance) result.fits.resize(mesh.vertex_count);
   LightAgreement agreement(input.rasters.size());  // a light file that contradicts the photos fails below
   const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
+  const bool with_materials = settings.fit_reflectance && settings.materials;  // material stage hook (issue 16)
+  MaterialSampleStore material_samples(with_materials ? mesh.vertex_count : 0);
   result.gather = gather_samples(
       mesh, input.rasters, lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
@@ -417,13 +438,16 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
         agreement.add(chunk, mesh, lights);
         apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
         consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
+        if (with_materials) material_samples.add_chunk(chunk, &result.fits[chunk.first_vertex], settings.phong);
       },
       gather_progress);
   result.seconds_gather = seconds_since(t);
   result.light_agreement = weakest_light_agreement(agreement, input.rasters);
   check_light_agreement(agreement, input.rasters, result.light_file);  // before anything is written
   result.colors = std::move(colors.viewpoints);
+  if (with_materials) run_material_stage(input, settings, material_samples, log, result);
   if (settings.fit_reflectance) fill_gaps(input, settings, log, result);
+  if (with_materials) propagate_material_labels(mesh, result.fits, result.materials.label);
 
   t = Clock::now();
   build_outputs(input, settings, result);

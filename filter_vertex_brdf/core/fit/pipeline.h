@@ -14,6 +14,7 @@
 #include "samples/diffuse_color.h"
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
+#include "fit/materials.h"
 #include "base/mesh_view.h"
 #include "io/output_ply.h"
 #include "samples/samples.h"
@@ -57,6 +58,11 @@ struct FitSettings {
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
   // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.
   int fill_unseen_rings = 0;
+  // Material stage (materials.h, issue 16): materials found from the data, a lobe per material
+  // from the pooled samples, every vertex of a glossy material with a specular term. CPU, after
+  // either fit back end. Keeps the usable samples in memory (28 bytes each) until the stage ran.
+  bool materials = false;
+  MaterialOptions material_options;
 };
 
 struct FitInput {
@@ -88,6 +94,7 @@ struct FitResult {
   size_t fit_weak = 0, fit_neighbours = 0;  // fit_status 4 and 3
   size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
   NeighbourFillStats fill;
+  MaterialResult materials;               // material stage (FitSettings::materials); label empty when off
   double seconds_fit = 0;
   std::string light_file;                 // the light file used (.lp, .json or .dome)
   std::string light_model;                // describe_lights: directional / point lights and their distances

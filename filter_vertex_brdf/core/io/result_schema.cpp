@@ -56,6 +56,9 @@ std::vector<ResultAttribute> make_schema() {
       {"fit_iterations", K::Count, G::PhongFit, false, "shininess iterations run",
        [](const R &r) { return float(r.fit.iterations); },
        [](R &r, float v) { r.fit.iterations = uint16_t(whole(v, 65535.0f)); }},
+      {"material", K::Code, G::PhongFit, false,
+       "material found from the data (materials = on): 1..K, listed in the report; 0 none (stage off, or no model)",
+       [](const R &r) { return r.material; }, [](R &r, float v) { r.material = whole(v, 65535.0f); }},
   };
 }
 } // namespace

@@ -21,6 +21,7 @@ struct VertexRecord {
   float diffuse[3] = {0.0f, 0.0f, 0.0f};  // linear k_d C shown (0 without a model)
   float n_visible = 0.0f, n_diffuse = 0.0f, n_specular = 0.0f;
   float coloured = 0.0f;  // 0 input colour kept, 1 clean pixels, 2 rim/mixed pixels only, 3 neighbours
+  float material = 0.0f;  // material stage (materials.h): 1..K, 0 = none (stage off, or no model)
   VertexFit fit = {{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0, kFitNone, 0};  // sentinels
 };
 

@@ -1,0 +1,759 @@
+#include "fit/materials.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace vbrdf {
+
+// ---- Sample store ----
+
+MaterialSampleStore::MaterialSampleStore(size_t vertex_count) : begin_(vertex_count, 0), end_(vertex_count, 0) {}
+
+void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o) {
+  for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
+    const size_t v = size_t(chunk.first_vertex) + i;
+    if (v >= begin_.size()) break;
+    const bool weak = fits[i].status == kFitFromWeakSamples;
+    begin_[v] = data_.size();
+    for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
+      const Sample &s = chunk.samples[k];
+      // The fit's usable-sample rules (phong_fit_cpu.cpp usable_samples), strict or weak.
+      if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0)) continue;
+      if ((s.flags & kMixedPixel) && !weak) continue;
+      if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) continue;
+      if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) ||
+          !std::isfinite(s.r_dot_e) || !std::isfinite(s.n_dot_l))
+        continue;
+      const float w = s.n_dot_l * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
+      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.n_dot_l, 1.0f), s.r_dot_e, w, s.raster, s.flags});
+    }
+    end_[v] = data_.size();
+  }
+}
+
+std::vector<Sample> MaterialSampleStore::as_samples(size_t v) const {
+  std::vector<Sample> out;
+  for (uint64_t k = begin_[v]; k < end_[v]; ++k) {
+    const Entry &e = data_[k];
+    out.push_back({{e.rgb[0], e.rgb[1], e.rgb[2]}, e.d, e.s, e.raster, e.flags});
+  }
+  return out;
+}
+
+namespace {
+
+using Entry = MaterialSampleStore::Entry;
+enum SampleSet { kAll = 0, kTrain = 1, kHeld = 2 };
+
+// Per-vertex sums that do not depend on the lobe: a = sum w d^2, p_c = sum w d P_c, pp_c = sum w P_c^2.
+struct Static {
+  double a = 0, p[3] = {0, 0, 0}, pp[3] = {0, 0, 0};
+  uint32_t n = 0, n_high = 0;
+};
+// Lobe sums at one alpha: b = sum w d g, g2 = sum w g^2, q_c = sum w g P_c, g = s^alpha.
+struct Lobe {
+  double b = 0, g2 = 0, q[3] = {0, 0, 0};
+};
+
+struct Context {
+  const MaterialSampleStore &store;
+  const PhongFitOptions &o;
+  const MaterialOptions &mo;
+  std::vector<float> log_s;   // per entry: ln(min(s, 1)), or +1 for s <= 0 (no lobe)
+  std::vector<uint8_t> eligible;  // per vertex: refitted by the material stage
+  size_t n = 0;
+
+  bool in_set(const Entry &e, int set) const {
+    if (set == kAll) return true;
+    const bool held = mo.heldout_every > 1 && (e.raster % mo.heldout_every) == mo.heldout_every - 1;
+    return set == kHeld ? held : !held;
+  }
+};
+
+inline double lobe_of(float log_s, double alpha) {
+  if (log_s > 0) return 0;
+  return std::exp(std::max(alpha * double(log_s), -80.0));
+}
+
+std::vector<Static> static_sums(const Context &c, int set) {
+  std::vector<Static> out(c.n);
+  const auto &E = c.store.entries();
+#pragma omp parallel for schedule(dynamic, 512) if (c.store.entries().size() > 200000)
+  for (long long v = 0; v < (long long)c.n; ++v) {
+    if (!c.eligible[size_t(v)]) continue;
+    Static &S = out[size_t(v)];
+    for (uint64_t k = c.store.first(size_t(v)); k < c.store.last(size_t(v)); ++k) {
+      const Entry &e = E[k];
+      if (!c.in_set(e, set)) continue;
+      S.a += double(e.w) * e.d * e.d;
+      for (int ch = 0; ch < 3; ++ch) S.p[ch] += double(e.w) * e.d * e.rgb[ch], S.pp[ch] += double(e.w) * e.rgb[ch] * e.rgb[ch];
+      ++S.n;
+      S.n_high += (e.flags & kHighlight) != 0;
+    }
+  }
+  return out;
+}
+
+// Lobe sums of every eligible vertex at alpha_of[label[v]] (label 0: skipped).
+std::vector<Lobe> lobe_sums(const Context &c, int set, const std::vector<int32_t> &label, const std::vector<double> &alpha_of) {
+  std::vector<Lobe> out(c.n);
+  const auto &E = c.store.entries();
+#pragma omp parallel for schedule(dynamic, 512) if (c.store.entries().size() > 200000)
+  for (long long v = 0; v < (long long)c.n; ++v) {
+    if (!c.eligible[size_t(v)] || label[size_t(v)] <= 0) continue;
+    const double alpha = alpha_of[size_t(label[size_t(v)])];
+    Lobe &L = out[size_t(v)];
+    for (uint64_t k = c.store.first(size_t(v)); k < c.store.last(size_t(v)); ++k) {
+      const Entry &e = E[k];
+      if (!c.in_set(e, set)) continue;
+      const double g = lobe_of(c.log_s[k], alpha);
+      if (g == 0) continue;
+      L.b += double(e.w) * e.d * g, L.g2 += double(e.w) * g * g;
+      for (int ch = 0; ch < 3; ++ch) L.q[ch] += double(e.w) * g * e.rgb[ch];
+    }
+  }
+  return out;
+}
+
+// k_s information and right-hand side after eliminating rho: I = 3 (g2 - b^2/a), r = sum_c (q_c - b p_c / a).
+inline void ks_equation(const Static &S, const Lobe &L, double &info, double &rhs) {
+  const double inv_a = S.a > 0 ? 1.0 / S.a : 0.0;
+  info = std::max(0.0, 3 * (L.g2 - L.b * L.b * inv_a));
+  rhs = 0;
+  for (int ch = 0; ch < 3; ++ch) rhs += L.q[ch] - L.b * S.p[ch] * inv_a;
+}
+
+inline double energy_fixed(const Static &S, const Lobe &L, double ks, const double rho[3]) {
+  double e = 0;
+  for (int ch = 0; ch < 3; ++ch)
+    e += S.pp[ch] - 2 * rho[ch] * S.p[ch] - 2 * ks * L.q[ch] + rho[ch] * rho[ch] * S.a + 2 * rho[ch] * ks * L.b +
+         ks * ks * L.g2;
+  return std::max(0.0, e);
+}
+
+// Energy with k_s fixed and rho re-solved exactly (non-negative); rho written when given.
+inline double energy_ks(const Static &S, const Lobe &L, double ks, double *rho_out = nullptr) {
+  double rho[3];
+  for (int ch = 0; ch < 3; ++ch) rho[ch] = S.a > 0 ? std::max(0.0, (S.p[ch] - L.b * ks) / S.a) : 0.0;
+  if (rho_out) std::copy(rho, rho + 3, rho_out);
+  return energy_fixed(S, L, ks, rho);
+}
+
+struct LobeFit {
+  double ks = 0, alpha = 1, energy = 0, energy_zero = 0, alpha_lo = 1, alpha_hi = 1;
+};
+
+std::vector<double> alpha_grid(const PhongFitOptions &o) {
+  std::vector<double> g;
+  const int n = 28;
+  const double lo = std::log(std::max(1.0, double(o.alpha_min))), hi = std::log(std::max(double(o.alpha_max), 2.0));
+  for (int i = 0; i < n; ++i) g.push_back(std::exp(lo + (hi - lo) * i / (n - 1)));
+  return g;
+}
+
+// Pooled lobes of materials 1..K (label[v]) on `set`: alpha over a log grid with parabolic
+// refinement in ln alpha, k_s in closed form (rho eliminated per vertex).
+std::vector<LobeFit> fit_lobes(const Context &c, int set, const std::vector<Static> &S, const std::vector<int32_t> &label,
+                               int K) {
+  const std::vector<double> grid = alpha_grid(c.o);
+  std::vector<std::vector<double>> E(size_t(K) + 1, std::vector<double>(grid.size(), 0.0)), KS = E;
+  std::vector<LobeFit> fit(size_t(K) + 1);
+  // k_s = 0 energies.
+  for (size_t v = 0; v < c.n; ++v)
+    if (c.eligible[v] && label[v] > 0) fit[size_t(label[v])].energy_zero += energy_ks(S[v], Lobe(), 0);
+  auto evaluate = [&](const std::vector<double> &alpha_of, std::vector<double> &ks_out, std::vector<double> &e_out) {
+    const std::vector<Lobe> L = lobe_sums(c, set, label, alpha_of);
+    std::vector<double> num(size_t(K) + 1, 0), den(size_t(K) + 1, 0);
+    for (size_t v = 0; v < c.n; ++v) {
+      if (!c.eligible[v] || label[v] <= 0) continue;
+      double info, rhs;
+      ks_equation(S[v], L[v], info, rhs);
+      num[size_t(label[v])] += rhs, den[size_t(label[v])] += info;
+    }
+    ks_out.assign(size_t(K) + 1, 0);
+    e_out.assign(size_t(K) + 1, 0);
+    for (int m = 1; m <= K; ++m)
+      ks_out[size_t(m)] = den[size_t(m)] > 0 ? std::min(std::max(num[size_t(m)] / den[size_t(m)], 0.0), double(c.o.ks_max)) : 0;
+    for (size_t v = 0; v < c.n; ++v)
+      if (c.eligible[v] && label[v] > 0) e_out[size_t(label[v])] += energy_ks(S[v], L[v], ks_out[size_t(label[v])]);
+  };
+  for (size_t i = 0; i < grid.size(); ++i) {
+    std::vector<double> ks, e;
+    evaluate(std::vector<double>(size_t(K) + 1, grid[i]), ks, e);
+    for (int m = 1; m <= K; ++m) E[size_t(m)][i] = e[size_t(m)], KS[size_t(m)][i] = ks[size_t(m)];
+  }
+  std::vector<double> refined(size_t(K) + 1, 1.0);
+  for (int m = 1; m <= K; ++m) {
+    const std::vector<double> &e = E[size_t(m)];
+    const size_t i = size_t(std::min_element(e.begin(), e.end()) - e.begin());
+    LobeFit &f = fit[size_t(m)];
+    f.alpha = grid[i], f.ks = KS[size_t(m)][i], f.energy = e[i];
+    f.alpha_lo = f.alpha_hi = grid[i];
+    for (size_t j = 0; j < grid.size(); ++j)
+      if (e[j] <= 1.01 * e[i] + 1e-300) f.alpha_lo = std::min(f.alpha_lo, grid[j]), f.alpha_hi = std::max(f.alpha_hi, grid[j]);
+    refined[size_t(m)] = f.alpha;
+    if (i > 0 && i + 1 < grid.size()) {  // parabola through the three points, in t = ln alpha (uniform spacing)
+      const double d2 = e[i - 1] - 2 * e[i] + e[i + 1];
+      if (d2 > 0) {
+        const double h = std::log(grid[1] / grid[0]);
+        const double dt = 0.5 * h * (e[i - 1] - e[i + 1]) / d2;
+        refined[size_t(m)] = std::exp(std::log(grid[i]) + std::max(-h, std::min(h, dt)));
+      }
+    }
+  }
+  std::vector<double> ks, e;
+  evaluate(refined, ks, e);
+  for (int m = 1; m <= K; ++m)
+    if (e[size_t(m)] < fit[size_t(m)].energy)
+      fit[size_t(m)].alpha = refined[size_t(m)], fit[size_t(m)].ks = ks[size_t(m)], fit[size_t(m)].energy = e[size_t(m)];
+  return fit;
+}
+
+// Compressed vertex adjacency.
+struct Adjacency {
+  std::vector<uint32_t> start, list;
+};
+Adjacency build_adjacency(const MeshView &mesh) {
+  std::vector<std::vector<uint32_t>> nb(mesh.vertex_count);
+  for (size_t t = 0; t + 2 < mesh.index_count; t += 3)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = mesh.indices[t + size_t(k)], b = mesh.indices[t + size_t((k + 1) % 3)];
+      if (a >= mesh.vertex_count || b >= mesh.vertex_count || a == b) continue;
+      nb[a].push_back(b), nb[b].push_back(a);
+    }
+  Adjacency adj;
+  adj.start.push_back(0);
+  for (auto &l : nb) {
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+    adj.list.insert(adj.list.end(), l.begin(), l.end());
+    adj.start.push_back(uint32_t(adj.list.size()));
+  }
+  return adj;
+}
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// Vertices without a label take the most common label among their labelled neighbours, ring by
+// ring through the whole mesh (vertices outside the stage pass labels on); an eligible vertex that
+// no label reaches takes its data's best label.
+void spread_labels(const Context &c, const Adjacency &adj, const std::vector<std::vector<double>> &cost, int K,
+                   std::vector<int32_t> &label) {
+  const size_t n = adj.start.size() - 1;
+  std::vector<int32_t> lab(n, 0);
+  for (size_t v = 0; v < std::min(n, c.n); ++v) lab[v] = c.eligible[v] ? label[v] : 0;
+  std::vector<int> count(size_t(K) + 1);
+  for (bool grew = true; grew;) {
+    grew = false;
+    std::vector<int32_t> next = lab;
+    for (size_t v = 0; v < n; ++v) {
+      if (lab[v] > 0) continue;
+      std::fill(count.begin(), count.end(), 0);
+      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k)
+        if (lab[adj.list[k]] > 0) ++count[size_t(lab[adj.list[k]])];
+      const int best = int(std::max_element(count.begin() + 1, count.end()) - count.begin());
+      if (count[size_t(best)] > 0) next[v] = best, grew = true;
+    }
+    lab.swap(next);
+  }
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v]) continue;
+    if (v < n && lab[v] > 0) {
+      label[v] = lab[v];
+      continue;
+    }
+    int best = 1;
+    for (int m = 2; m <= K; ++m)
+      if (cost[size_t(m)][v] < cost[size_t(best)][v]) best = m;
+    label[v] = best;
+  }
+}
+
+// Labels by the data (energy under each lobe over the residual variance) and the neighbours (ICM).
+void assign_labels(const Context &c, const Adjacency &adj, const std::vector<Static> &S, int set,
+                   const std::vector<LobeFit> &lobes, int K, std::vector<int32_t> &label) {
+  std::vector<std::vector<double>> cost(size_t(K) + 1, std::vector<double>(c.n, 0.0));
+  std::vector<int32_t> all_m(c.n, 0);
+  for (int m = 1; m <= K; ++m) {
+    for (size_t v = 0; v < c.n; ++v) all_m[v] = c.eligible[v] ? m : 0;
+    std::vector<double> alpha_of(size_t(K) + 1, lobes[size_t(m)].alpha);
+    const std::vector<Lobe> L = lobe_sums(c, set, all_m, alpha_of);
+    for (size_t v = 0; v < c.n; ++v)
+      if (c.eligible[v]) cost[size_t(m)][v] = energy_ks(S[v], L[v], lobes[size_t(m)].ks);
+  }
+  std::vector<double> emin(c.n, 0), var;
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v]) continue;
+    double e = cost[1][v];
+    for (int m = 2; m <= K; ++m) e = std::min(e, cost[size_t(m)][v]);
+    emin[v] = e;
+    if (S[v].n > 4) var.push_back(e / double(3 * S[v].n - 4));
+  }
+  const double floor_var = std::max(median_of(var), 1e-20);
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v]) continue;
+    const double var_v = S[v].n > 4 ? std::max(emin[v] / double(3 * S[v].n - 4), floor_var) : floor_var;
+    for (int m = 1; m <= K; ++m) cost[size_t(m)][v] = (cost[size_t(m)][v] - emin[v]) / (2 * var_v);
+  }
+  // Only vertices with a highlight sample (R.E > T_s) decide by their data: for the others the
+  // lobes differ only in their flanks, where the R.E form is least faithful. ICM among the deciding
+  // vertices, then the others take the label of the nearest deciding vertices over the mesh.
+  std::vector<uint8_t> decides(c.n, 0);
+  for (size_t v = 0; v < c.n; ++v) {
+    decides[v] = c.eligible[v] && S[v].n_high > 0;
+    if (!decides[v]) label[v] = 0;
+  }
+  std::vector<int> count(size_t(K) + 1);
+  for (int sweep = 0; sweep < 20; ++sweep) {
+    size_t changed = 0;
+    for (size_t v = 0; v < c.n; ++v) {
+      if (!decides[v]) continue;
+      std::fill(count.begin(), count.end(), 0);
+      int labelled = 0;
+      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k) {
+        const int32_t l = label[adj.list[k]];
+        if (l > 0 && l <= K) ++count[size_t(l)], ++labelled;
+      }
+      int best = label[v] > 0 && label[v] <= K ? label[v] : 1;
+      double best_cost = 1e300;
+      for (int m = 1; m <= K; ++m) {
+        const double cm = cost[size_t(m)][v] + c.mo.coherence * double(labelled - count[size_t(m)]);
+        if (cm < best_cost - 1e-12 || (std::fabs(cm - best_cost) <= 1e-12 && m == label[v])) best_cost = cm, best = m;
+      }
+      if (best != label[v]) label[v] = best, ++changed;
+    }
+    if (!changed) break;
+  }
+  spread_labels(c, adj, cost, K, label);
+}
+
+// Drops empty materials and renumbers 1..K'; returns K'.
+int compact_labels(const Context &c, int K, std::vector<int32_t> &label) {
+  std::vector<size_t> count(size_t(K) + 1, 0);
+  for (size_t v = 0; v < c.n; ++v)
+    if (c.eligible[v] && label[v] > 0) ++count[size_t(label[v])];
+  std::vector<int32_t> map(size_t(K) + 1, 0);
+  int k = 0;
+  for (int m = 1; m <= K; ++m)
+    if (count[size_t(m)]) map[size_t(m)] = ++k;
+  for (size_t v = 0; v < c.n; ++v) label[v] = c.eligible[v] && label[v] > 0 ? map[size_t(label[v])] : 0;
+  return k;
+}
+
+// Initial labels for K materials: weighted 1-D k-means of the per-vertex k_s at the pooled alpha.
+std::vector<int32_t> initial_labels(const Context &c, const Adjacency &adj, const std::vector<Static> &S, int set,
+                                    double alpha, int K) {
+  std::vector<int32_t> label(c.n, 0), ones(c.n, 0);
+  for (size_t v = 0; v < c.n; ++v) ones[v] = c.eligible[v] ? 1 : 0;
+  const std::vector<Lobe> L = lobe_sums(c, set, ones, std::vector<double>(2, alpha));
+  std::vector<double> ks(c.n, 0), w(c.n, 0), infos;
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v]) continue;
+    double info, rhs;
+    ks_equation(S[v], L[v], info, rhs);
+    w[v] = info;
+    ks[v] = info > 0 ? std::max(0.0, rhs / info) : 0;
+    if (info > 0) infos.push_back(info);
+  }
+  const double min_info = 0.01 * median_of(infos);
+  std::vector<size_t> order;
+  for (size_t v = 0; v < c.n; ++v)
+    if (c.eligible[v] && w[v] > min_info && S[v].n_high > 0) order.push_back(v);
+  for (size_t v = 0; v < c.n; ++v) label[v] = c.eligible[v] ? 1 : 0;
+  if (K <= 1 || order.empty()) return label;
+  for (size_t v = 0; v < c.n; ++v) label[v] = 0;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return ks[a] < ks[b]; });
+  double total = 0;
+  for (size_t v : order) total += w[v];
+  std::vector<double> centre(static_cast<size_t>(K), 0.0);
+  double acc = 0;
+  size_t j = 0;
+  for (int m = 0; m < K; ++m) {  // weighted quantiles (m + 0.5) / K
+    const double target = total * (m + 0.5) / K;
+    while (j + 1 < order.size() && acc + w[order[j]] < target) acc += w[order[j++]];
+    centre[size_t(m)] = ks[order[j]];
+  }
+  std::vector<int32_t> assign(c.n, 0);
+  for (int it = 0; it < 30; ++it) {
+    std::vector<double> sw(size_t(K), 0), swx(size_t(K), 0);
+    for (size_t v : order) {
+      int best = 0;
+      for (int m = 1; m < K; ++m)
+        if (std::fabs(ks[v] - centre[size_t(m)]) < std::fabs(ks[v] - centre[size_t(best)])) best = m;
+      assign[v] = best;
+      sw[size_t(best)] += w[v], swx[size_t(best)] += w[v] * ks[v];
+    }
+    for (int m = 0; m < K; ++m)
+      if (sw[size_t(m)] > 0) centre[size_t(m)] = swx[size_t(m)] / sw[size_t(m)];
+  }
+  for (size_t v : order) label[v] = assign[v] + 1;
+  spread_labels(c, adj, std::vector<std::vector<double>>(size_t(K) + 1, std::vector<double>(c.n, 0.0)), K, label);
+  return label;
+}
+
+// Per-vertex parameters of a labelling, for one choice of priors: alpha = the material's alpha times
+// 2^(k/4), k in [-8, 8] (only k = 0 when alpha_prior < 0), with a quadratic prior on ln alpha of
+// weight alpha_prior x (the material's mean k_s information x k_s^2); k_s regularised towards the
+// material's with weight prior x the mean information; rho re-solved exactly.
+struct Choice {
+  float prior;        // k_s prior strength
+  float alpha_prior;  // < 0: the material's alpha only
+};
+constexpr int kAlphaSteps = 17, kAlphaCentre = 8;
+
+struct Params {
+  std::vector<double> ks, rho, alpha;  // rho: 3 per vertex
+};
+
+// For every choice, the error of its parameters (fitted on `fit_set`) at `score_set` (summed over
+// the vertices), and, when `params` is given, the parameters of choice 0.
+std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &S_fit, const std::vector<Static> &S_score,
+                                   int fit_set, int score_set, const std::vector<int32_t> &label,
+                                   const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse, int K,
+                                   const std::vector<Choice> &choices, Params *params) {
+  // The material's mean k_s information at its alpha: the scale of both priors.
+  std::vector<double> alpha_of(size_t(K) + 1, 1.0);
+  for (int m = 1; m <= K; ++m) alpha_of[size_t(m)] = lobes[size_t(m)].alpha;
+  const std::vector<Lobe> L0 = lobe_sums(c, fit_set, label, alpha_of);
+  std::vector<double> mean_info(size_t(K) + 1, 0), cnt(size_t(K) + 1, 0);
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v] || label[v] <= 0) continue;
+    double info, rhs;
+    ks_equation(S_fit[v], L0[v], info, rhs);
+    if (info > 0) mean_info[size_t(label[v])] += info, cnt[size_t(label[v])] += 1;
+  }
+  for (int m = 1; m <= K; ++m) mean_info[size_t(m)] = cnt[size_t(m)] > 0 ? mean_info[size_t(m)] / cnt[size_t(m)] : 0;
+  const size_t nc = choices.size();
+  std::vector<double> score(c.n * nc, 0.0);
+  if (params) params->ks.assign(c.n, 0), params->rho.assign(3 * c.n, 0), params->alpha.assign(c.n, 0);
+  const auto &E = c.store.entries();
+#pragma omp parallel for schedule(dynamic, 256) if (c.store.entries().size() > 200000)
+  for (long long vi = 0; vi < (long long)c.n; ++vi) {
+    const size_t v = size_t(vi);
+    if (!c.eligible[v] || label[v] <= 0) continue;
+    const size_t m = size_t(label[v]);
+    if (diffuse[m]) {
+      double rho[3];
+      energy_ks(S_fit[v], Lobe(), 0, rho);
+      const double e = energy_fixed(S_score[v], Lobe(), 0, rho);
+      for (size_t ch = 0; ch < nc; ++ch) score[v * nc + ch] = e;
+      if (params) std::copy(rho, rho + 3, &params->rho[3 * v]);
+      continue;
+    }
+    Lobe Lf[kAlphaSteps], Ls[kAlphaSteps];
+    double alpha[kAlphaSteps];
+    for (int k = 0; k < kAlphaSteps; ++k)
+      alpha[k] = std::min(std::max(lobes[m].alpha * std::pow(2.0, (k - kAlphaCentre) / 4.0), double(c.o.alpha_min)),
+                          double(c.o.alpha_max));
+    for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
+      const Entry &e = E[i];
+      const bool f = c.in_set(e, fit_set), sc = c.in_set(e, score_set);
+      if ((!f && !sc) || c.log_s[i] > 0) continue;
+      for (int k = 0; k < kAlphaSteps; ++k) {
+        const double g = lobe_of(c.log_s[i], alpha[k]);
+        if (g == 0) continue;
+        for (Lobe *L : {f ? &Lf[k] : nullptr, sc ? &Ls[k] : nullptr}) {
+          if (!L) continue;
+          L->b += double(e.w) * e.d * g, L->g2 += double(e.w) * g * g;
+          for (int ch = 0; ch < 3; ++ch) L->q[ch] += double(e.w) * g * e.rgb[ch];
+        }
+      }
+    }
+    for (size_t ch = 0; ch < nc; ++ch) {
+      const double lambda = choices[ch].prior * mean_info[m];
+      const double mu = choices[ch].alpha_prior * mean_info[m] * lobes[m].ks * lobes[m].ks;
+      int best_k = kAlphaCentre;
+      double best_obj = 1e300, best_ks = 0;
+      for (int k = 0; k < kAlphaSteps; ++k) {
+        if (choices[ch].alpha_prior < 0 && k != kAlphaCentre) continue;
+        double info, rhs;
+        ks_equation(S_fit[v], Lf[k], info, rhs);
+        double ks = info + lambda > 0 ? (rhs + lambda * lobes[m].ks) / (info + lambda) : lobes[m].ks;
+        ks = std::min(std::max(ks, 0.0), double(c.o.ks_max));
+        const double t = std::log(alpha[k] / lobes[m].alpha);
+        const double obj = energy_ks(S_fit[v], Lf[k], ks) + lambda * (ks - lobes[m].ks) * (ks - lobes[m].ks) +
+                           std::max(0.0, double(mu)) * t * t;
+        if (obj < best_obj) best_obj = obj, best_k = k, best_ks = ks;
+      }
+      double rho[3];
+      energy_ks(S_fit[v], Lf[best_k], best_ks, rho);
+      score[v * nc + ch] = energy_fixed(S_score[v], Ls[best_k], best_ks, rho);
+      if (params && ch == 0) {
+        params->ks[v] = best_ks, params->alpha[v] = alpha[best_k];
+        std::copy(rho, rho + 3, &params->rho[3 * v]);
+      }
+    }
+  }
+  std::vector<double> total(nc, 0.0);
+  for (size_t v = 0; v < c.n; ++v)
+    if (S_fit[v].n > 0)
+      for (size_t ch = 0; ch < nc; ++ch) total[ch] += score[v * nc + ch];
+  return total;
+}
+
+std::vector<uint8_t> diffuse_flags(const std::vector<LobeFit> &lobes, const std::vector<double> &median_kd, int K,
+                                   const MaterialOptions &mo) {
+  std::vector<uint8_t> d(size_t(K) + 1, 0);
+  for (int m = 1; m <= K; ++m)
+    d[size_t(m)] = lobes[size_t(m)].ks <= mo.diffuse_ks_fraction * median_kd[size_t(m)] || lobes[size_t(m)].alpha <= mo.min_lobe_alpha;
+  return d;
+}
+
+std::vector<double> median_kd_of(const Context &c, const std::vector<VertexFit> &fits, const std::vector<int32_t> &label, int K) {
+  std::vector<std::vector<double>> kd(size_t(K) + 1);
+  for (size_t v = 0; v < c.n; ++v)
+    if (c.eligible[v] && label[v] > 0) kd[size_t(label[v])].push_back(fits[v].kd);
+  std::vector<double> out(size_t(K) + 1, 0);
+  for (int m = 1; m <= K; ++m) out[size_t(m)] = median_of(kd[size_t(m)]);
+  return out;
+}
+
+// One robust pass on k_d C with the lobe fixed (as the basic colour's, diffuse_color.h): samples
+// whose residual exceeds 3 scaled MADs (shadow edges the depth passes miss) are dropped and rho is
+// re-solved from the rest; unchanged when fewer than 4 samples remain.
+void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[3]) {
+  const auto &E = c.store.entries();
+  std::vector<double> res;
+  for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
+    const Entry &e = E[i];
+    const double g = ks > 0 ? ks * lobe_of(c.log_s[i], alpha) : 0.0;
+    double r = 0;
+    for (int ch = 0; ch < 3; ++ch) r += std::fabs(e.rgb[ch] - rho[ch] * e.d - g);
+    res.push_back(r / 3);
+  }
+  if (res.size() < 6) return;
+  std::vector<double> sorted = res;
+  const double med = median_of(sorted);
+  for (double &x : sorted) x = std::fabs(x - med);
+  const double mad = 1.4826 * median_of(sorted);
+  if (!(mad > 0)) return;
+  double a = 0, p[3] = {0, 0, 0};
+  size_t kept = 0;
+  for (uint64_t i = c.store.first(v), j = 0; i < c.store.last(v); ++i, ++j) {
+    if (std::fabs(res[j] - med) > 3 * mad) continue;
+    const Entry &e = E[i];
+    const double g = ks > 0 ? ks * lobe_of(c.log_s[i], alpha) : 0.0;
+    a += double(e.w) * e.d * e.d;
+    for (int ch = 0; ch < 3; ++ch) p[ch] += double(e.w) * e.d * (e.rgb[ch] - g);
+    ++kept;
+  }
+  if (kept < 4 || !(a > 0)) return;
+  for (int ch = 0; ch < 3; ++ch) rho[ch] = std::max(0.0, p[ch] / a);
+}
+
+struct Config {
+  int K = 0;
+  std::vector<int32_t> label;
+  std::vector<LobeFit> lobes;
+};
+
+// Alternates lobe fits and assignments on `set`, starting from `label`.
+Config cluster(const Context &c, const Adjacency &adj, const std::vector<Static> &S, int set, std::vector<int32_t> label,
+               int K, int iterations) {
+  Config cfg;
+  K = compact_labels(c, K, label);
+  std::vector<LobeFit> lobes = fit_lobes(c, set, S, label, K);
+  for (int it = 0; it < iterations && K > 1; ++it) {
+    const std::vector<int32_t> before = label;
+    assign_labels(c, adj, S, set, lobes, K, label);
+    K = compact_labels(c, K, label);
+    lobes = fit_lobes(c, set, S, label, K);
+    if (label == before) break;
+  }
+  cfg.K = K, cfg.label = std::move(label), cfg.lobes = std::move(lobes);
+  return cfg;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+} // namespace
+
+MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &store, const PhongFitOptions &o,
+                             const MaterialOptions &mo, const float *diffuse_rgb, const uint8_t *diffuse_valid,
+                             std::vector<VertexFit> &fits) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MaterialResult R;
+  Context c{store, o, mo, {}, {}, std::min(mesh.vertex_count, std::min(store.vertex_count(), fits.size()))};
+  R.label.assign(fits.size(), 0);
+  R.bytes_kept = store.bytes();
+  c.eligible.assign(c.n, 0);
+  size_t eligible = 0;
+  for (size_t v = 0; v < c.n; ++v) {
+    const uint8_t st = fits[v].status;
+    c.eligible[v] = (st == kFitFull || st == kFitDiffuseOnly || st == kFitFromWeakSamples) && store.last(v) > store.first(v);
+    eligible += c.eligible[v];
+  }
+  if (!eligible) {
+    R.report = "materials: no vertex with samples: stage skipped\n";
+    return R;
+  }
+  c.log_s.resize(store.entries().size());
+  for (size_t k = 0; k < c.log_s.size(); ++k) {
+    const float s = store.entries()[k].s;
+    c.log_s[k] = s > 0 ? std::log(std::min(s, 1.0f)) : 1.0f;
+  }
+  const Adjacency adj = build_adjacency(mesh);
+  std::ostringstream rep;
+
+  // 1. Choose K and the prior on the training photos, by the error at the held-out ones.
+  const std::vector<Static> S_train = static_sums(c, kTrain), S_held = static_sums(c, kHeld);
+  std::vector<int32_t> ones(c.n, 0);
+  for (size_t v = 0; v < c.n; ++v) ones[v] = c.eligible[v] ? 1 : 0;
+  const std::vector<LobeFit> one = fit_lobes(c, kTrain, S_train, ones, 1);
+  std::vector<Config> configs;
+  std::vector<Choice> best_choice, choices;
+  for (float prior : mo.prior_strengths)
+    for (float alpha_prior : mo.alpha_prior_strengths) choices.push_back({prior, alpha_prior});
+  if (choices.empty()) choices.push_back({1.0f, -1.0f});
+  const int kmax = std::max(1, mo.max_materials);
+  for (int K = 1; K <= kmax; ++K) {
+    Config cfg = K == 1 ? Config{1, ones, one} : cluster(c, adj, S_train, kTrain, initial_labels(c, adj, S_train, kTrain, one[1].alpha, K), K, mo.iterations);
+    if (cfg.K < K && K > 1) {  // collapsed to fewer materials: nothing new to score
+      R.heldout_error.push_back(R.heldout_error.empty() ? 0 : R.heldout_error.back());
+      configs.push_back(cfg);
+      best_choice.push_back(best_choice.empty() ? choices.front() : best_choice.back());
+      continue;
+    }
+    const std::vector<uint8_t> diffuse = diffuse_flags(cfg.lobes, median_kd_of(c, fits, cfg.label, cfg.K), cfg.K, mo);
+    const std::vector<double> err = solve_vertices(c, S_train, S_held, kTrain, kHeld, cfg.label, cfg.lobes, diffuse, cfg.K, choices, nullptr);
+    const size_t b = size_t(std::min_element(err.begin(), err.end()) - err.begin());
+    const double best = err[b];
+    const Choice choice_best = choices[b];
+    R.heldout_error.push_back(best);
+    configs.push_back(std::move(cfg));
+    best_choice.push_back(choice_best);
+  }
+  const double best_error = *std::min_element(R.heldout_error.begin(), R.heldout_error.end());
+  size_t chosen = 0;
+  while (chosen + 1 < R.heldout_error.size() && R.heldout_error[chosen] > (1 + mo.choose_tolerance) * best_error) ++chosen;
+  R.chosen_prior = best_choice[chosen].prior;
+  R.chosen_alpha_prior = best_choice[chosen].alpha_prior;
+  rep << "materials (issue 16): chosen by held-out error (every " << mo.heldout_every << "th photo left out, fitted on the "
+      << "others): ";
+  for (size_t k = 0; k < R.heldout_error.size(); ++k)
+    rep << (k ? ", " : "") << "K=" << k + 1 << " " << fixed(R.heldout_error[k] / std::max(best_error, 1e-300), 4);
+  rep << " (relative to the best); smallest K within " << fixed(100 * mo.choose_tolerance, 1) << " % of the best: "
+      << configs[chosen].K << "; k_s prior strength " << R.chosen_prior << ", per-vertex alpha "
+      << (R.chosen_alpha_prior < 0 ? std::string("= the material's") : "prior strength " + fixed(R.chosen_alpha_prior, 3))
+      << "\n";
+
+  // 2. Refit the chosen configuration on all samples.
+  const std::vector<Static> S = static_sums(c, kAll);
+  Config fin = cluster(c, adj, S, kAll, configs[chosen].label, configs[chosen].K, configs[chosen].K > 1 ? 2 : 0);
+  const int K = fin.K;
+  R.chosen_k = K;
+  std::vector<double> alpha_of(size_t(K) + 1, 1.0);
+  for (int m = 1; m <= K; ++m) alpha_of[size_t(m)] = fin.lobes[size_t(m)].alpha;
+  const std::vector<Lobe> L = lobe_sums(c, kAll, fin.label, alpha_of);
+  const std::vector<double> median_kd = median_kd_of(c, fits, fin.label, K);
+  const std::vector<uint8_t> diffuse = diffuse_flags(fin.lobes, median_kd, K, mo);
+  Params P;
+  solve_vertices(c, S, S, kAll, kAll, fin.label, fin.lobes, diffuse, K, {best_choice[chosen]}, &P);
+
+  // 3. Write the fits.
+  R.materials.resize(size_t(K));
+  for (size_t v = 0; v < c.n; ++v) {
+    if (!c.eligible[v] || fin.label[v] <= 0) continue;
+    const size_t m = size_t(fin.label[v]);
+    R.label[v] = int32_t(m);
+    Material &mat = R.materials[m - 1];
+    ++mat.vertices;
+    mat.samples += S[v].n, mat.highlight_samples += S[v].n_high;
+    double info, rhs;
+    ks_equation(S[v], L[v], info, rhs);
+    mat.evidence_vertices += info > 0;
+    VertexFit &f = fits[v];
+    const bool had_ks = f.ks > 0;
+    const bool weak = f.status == kFitFromWeakSamples;
+    if (mo.keep_full_fits && !diffuse[m] && f.status == kFitFull && f.ks > 0) continue;
+    const std::vector<Sample> samples = store.as_samples(v);
+    if (diffuse[m] && diffuse_rgb && diffuse_valid && diffuse_valid[v] && !weak) {
+      set_diffuse_only_reflectance(samples.data(), samples.size(), o, diffuse_rgb + 3 * v, f);
+    } else {
+      double rho[3] = {P.rho[3 * v], P.rho[3 * v + 1], P.rho[3 * v + 2]};
+      if (mo.robust_colour) robust_rho(c, v, diffuse[m] ? 0.0 : P.ks[v], P.alpha[v], rho);
+      const double kd = std::max(rho[0], std::max(rho[1], rho[2]));
+      if (!(S[v].a > 0) && !diffuse[m]) {
+        // No diffuse information (cannot happen with a usable sample, but stay safe): keep k_d C.
+      } else {
+        f.kd = float(std::min(kd, double(o.kd_max)));
+        for (int ch = 0; ch < 3; ++ch) f.color[ch] = kd > 0 ? float(std::min(1.0, rho[ch] / kd)) : 0.0f;
+      }
+      f.ks = diffuse[m] ? 0.0f : float(P.ks[v]);
+      f.shininess = f.ks > 0 ? float(P.alpha[v]) : 0.0f;
+      if (!weak) f.status = f.ks > 0 ? kFitFull : kFitDiffuseOnly;
+      recompute_fit_quality(samples.data(), samples.size(), o, weak, f);
+    }
+    R.vertices_changed_to_specular += !had_ks && f.ks > 0;
+    R.vertices_set_diffuse += had_ks && !(f.ks > 0);
+  }
+  for (int m = 1; m <= K; ++m) {
+    Material &mat = R.materials[size_t(m) - 1];
+    const LobeFit &lf = fin.lobes[size_t(m)];
+    mat.diffuse = diffuse[size_t(m)] != 0;
+    mat.ks = mat.diffuse ? 0 : lf.ks;
+    mat.shininess = mat.diffuse ? 0 : lf.alpha;
+    mat.shininess_lo = lf.alpha_lo, mat.shininess_hi = lf.alpha_hi;
+    mat.median_kd = median_kd[size_t(m)];
+    mat.lobe_gain = lf.energy_zero > 0 ? (lf.energy_zero - lf.energy) / lf.energy_zero : 0;
+    rep << "  material " << m << ": " << mat.vertices << " vertices (" << mat.evidence_vertices
+        << " with specular information of their own), " << mat.samples << " samples, " << mat.highlight_samples
+        << " highlight samples; pooled lobe k_s " << fixed(lf.ks, 4) << ", alpha (R.E) " << fixed(lf.alpha, 1)
+        << " (within 1 % of the best energy for alpha " << fixed(lf.alpha_lo, 1) << ".." << fixed(lf.alpha_hi, 1)
+        << "), the lobe lowers the pooled energy by " << fixed(100 * mat.lobe_gain, 2) << " %; median k_d "
+        << fixed(mat.median_kd, 4);
+    if (mat.diffuse)
+      rep << "; DIFFUSE (k_s below " << fixed(100 * mo.diffuse_ks_fraction, 1) << " % of k_d, or alpha <= " << fixed(mo.min_lobe_alpha, 1)
+          << "): k_s = 0, specular stages skipped for its vertices";
+    rep << "\n";
+  }
+  R.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rep << "  vertices given a lobe that had none: " << R.vertices_changed_to_specular
+      << "; vertices set diffuse (in a diffuse material): " << R.vertices_set_diffuse << "; samples kept "
+      << fixed(double(R.bytes_kept) / (1 << 20), 1) << " MB; " << fixed(R.seconds, 2) << " s (CPU, double)\n";
+  R.report = rep.str();
+  return R;
+}
+
+void propagate_material_labels(const MeshView &mesh, const std::vector<VertexFit> &fits, std::vector<int32_t> &label) {
+  const size_t n = std::min({mesh.vertex_count, fits.size(), label.size()});
+  const Adjacency adj = build_adjacency(mesh);
+  for (int pass = 0; pass < 1000; ++pass) {
+    std::vector<int32_t> next = label;
+    size_t changed = 0;
+    for (size_t v = 0; v < n; ++v) {
+      if (label[v] > 0 || !has_model(fits[v])) continue;
+      std::vector<int32_t> seen;
+      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k)
+        if (adj.list[k] < n && label[adj.list[k]] > 0) seen.push_back(label[adj.list[k]]);
+      if (seen.empty()) continue;
+      std::sort(seen.begin(), seen.end());
+      int32_t best = seen[0];
+      size_t best_count = 0;
+      for (size_t i = 0; i < seen.size();) {
+        size_t j = i;
+        while (j < seen.size() && seen[j] == seen[i]) ++j;
+        if (j - i > best_count) best_count = j - i, best = seen[i];
+        i = j;
+      }
+      next[v] = best, ++changed;
+    }
+    label.swap(next);
+    if (!changed) break;
+  }
+}
+
+} // namespace vbrdf

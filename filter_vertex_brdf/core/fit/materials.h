@@ -1,0 +1,134 @@
+#pragma once
+// Materials found from the data, and a specular lobe per material (issue 16, first step).
+//
+// After the per-vertex Phong fit, the modelled vertices are grouped into a few materials by their
+// specular response, a lobe (k_s, alpha on R.E) is fitted per material from the pooled samples of
+// all its vertices, and every vertex of a glossy material gets a specular term. A vertex whose own
+// fit found a lobe (fit_status 2, k_s > 0) keeps it (MaterialOptions::keep_full_fits, default);
+// every other vertex of a glossy material (or every one, keep_full_fits = false) gets
+//   alpha = its material's alpha; k_s = a per-vertex least-squares k_s regularised towards the
+//   material's k_s (a quadratic prior of weight lambda = prior_strength x the material's mean
+//   per-vertex k_s information), k_d C re-solved exactly for that lobe (then one robust 3-MAD pass).
+//   A vertex with no specular evidence of its own gets the material's k_s. When the held-out error
+//   prefers it, alpha is per vertex too, within a factor 4 of the material's, with a prior on ln alpha.
+// A material whose pooled k_s is below `diffuse_ks_fraction` of its median k_d, or whose alpha is
+// at most `min_lobe_alpha`, is diffuse: its
+// vertices get k_s = 0 (their diffuse-only reflectance), and the report says so.
+//
+// Grouping: for K = 1..max_materials, labels start from a weighted 1-D k-means of the per-vertex k_s
+// (at the one-material lobe's alpha) and alternate between pooled lobe fits and assignment by the
+// per-vertex energy under each lobe (exact linear re-solve of k_d C), with mesh adjacency keeping
+// regions coherent (ICM: each neighbour with another label costs `coherence`, the data term is the
+// energy difference over the vertex's residual variance). Only vertices with a highlight sample
+// decide by their data; the others take the label of the nearest deciding vertices over the mesh.
+// K, and the prior strengths, are chosen by held-out error: every
+// `heldout_every`-th photo is left out, the model is fitted on the others and scored on it; the
+// smallest K whose held-out error is within `choose_tolerance` of the best wins. The chosen
+// configuration is then refitted on all samples.
+//
+// Diffuse chromaticity is deliberately not a feature: on the shared scenes colour is a texture that
+// crosses material boundaries (spot: one coating over a textured albedo; bunny: colour bands cross
+// the glossy/diffuse split), and the held-out criterion judges the specular model only.
+//
+// Samples: the fit's usable samples (phong_fit.h rules: lit, unsaturated, clean, N.L > 0, not
+// grazing unless a highlight; for fit_status 4 vertices the weak rules: grazing kept, mixed
+// pixels at mixed_sample_weight) are kept per vertex while the chunks stream (28 bytes each; the
+// report states the memory). Weights w = N.L as in the fit. Double precision, CPU, for either fit
+// back end. Safeguards: no sample, a = sum w d^2 = 0, or no specular information give k_s = the
+// material's (or 0) and k_d C from the existing fit; all outputs finite; k_s in [0, ks_max].
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "base/mesh_view.h"
+#include "fit/phong_fit.h"
+#include "samples/samples.h"
+
+namespace vbrdf {
+
+struct MaterialOptions {
+  int max_materials = 4;
+  int heldout_every = 4;             // photos with index % heldout_every == heldout_every - 1 are held out
+  float choose_tolerance = 0.005f;   // relative held-out error within which a smaller K is preferred
+  float diffuse_ks_fraction = 0.01f; // pooled k_s below this fraction of the median k_d: diffuse material
+  std::vector<float> prior_strengths = {0.0f, 0.25f, 1.0f, 4.0f};  // k_s prior candidates, chosen by held-out error
+  // Per-vertex alpha: candidates for the strength of its prior towards the material's alpha
+  // (< 0: the material's alpha itself), chosen by held-out error with the k_s prior.
+  std::vector<float> alpha_prior_strengths = {-1.0f, 0.0f, 0.1f, 1.0f};
+  float coherence = 1.0f;            // ICM cost per disagreeing neighbour (log-likelihood units)
+  int iterations = 4;                // lobe fit / assignment alternations
+  // true: vertices whose own fit has a lobe (fit_status 2, k_s > 0) keep it; only the others (the
+  // per-vertex rule left them diffuse-only, or weak) take the material's lobe. false: every vertex
+  // of a glossy material gets the material-regularised k_s and alpha.
+  bool keep_full_fits = true;
+  // A pooled lobe with alpha at or below this is no highlight (R.E^alpha with alpha ~ 1 is a broad
+  // cosine that only absorbs shading-model misfit): the material is treated as diffuse.
+  float min_lobe_alpha = 2.0f;
+  bool robust_colour = true;         // one 3-MAD outlier pass on k_d C with the lobe fixed (final fit only)
+};
+
+struct Material {
+  uint32_t vertices = 0;           // vertices labelled with it
+  uint32_t evidence_vertices = 0;  // of which with specular information of their own
+  uint64_t samples = 0, highlight_samples = 0;
+  double ks = 0, shininess = 0;    // pooled lobe (diffuse: 0, 0)
+  double shininess_lo = 0, shininess_hi = 0;  // alpha range whose pooled energy is within 1 % of the minimum
+  double median_kd = 0;
+  double lobe_gain = 0;            // relative energy drop of the lobe over k_s = 0 (pooled)
+  bool diffuse = false;
+};
+
+struct MaterialResult {
+  std::vector<Material> materials;     // index = label - 1
+  std::vector<int32_t> label;          // per vertex: 1..K, 0 = no material (no model)
+  std::vector<double> heldout_error;   // per K tried (K = index + 1), sum of weighted squared residuals
+  int chosen_k = 0;
+  float chosen_prior = 0;
+  float chosen_alpha_prior = -1;       // < 0: every vertex has its material's alpha
+  uint64_t vertices_changed_to_specular = 0;  // diffuse-only before, a lobe now
+  uint64_t vertices_set_diffuse = 0;           // had k_s > 0, now in a diffuse material
+  size_t bytes_kept = 0;
+  double seconds = 0;
+  std::string report;                  // lines for the fit report
+};
+
+// The fit's usable samples of every vertex, kept while the chunks stream.
+class MaterialSampleStore {
+public:
+  explicit MaterialSampleStore(size_t vertex_count = 0);
+  // Keeps the usable samples of the chunk's vertices; `fits` are the chunk's fits (their status
+  // picks the strict or the weak sample rules). Call once per chunk, before or after the fit.
+  void add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o);
+  struct Entry {
+    float rgb[3];
+    float d, s, w;      // N.L, R.E, weight
+    uint16_t raster;
+    uint16_t flags;     // SampleFlag bits of the sample
+  };
+  size_t vertex_count() const { return begin_.size(); }
+  uint64_t first(size_t v) const { return begin_[v]; }  // index range [first, last) into entries()
+  uint64_t last(size_t v) const { return end_[v]; }
+  const std::vector<Entry> &entries() const { return data_; }
+  size_t bytes() const { return data_.capacity() * sizeof(Entry) + 2 * begin_.capacity() * sizeof(uint64_t); }
+  // Raw samples (for quality metrics) in Sample form, of vertex v.
+  std::vector<Sample> as_samples(size_t v) const;
+
+private:
+  std::vector<uint64_t> begin_, end_;
+  std::vector<Entry> data_;
+};
+
+// Finds the materials, fits their lobes and rewrites the fits of the modelled vertices (see top).
+// `diffuse_rgb` (may be null): per vertex a robust diffuse-only reflectance (3 floats) with a
+// validity flag per vertex in `diffuse_valid`, used for vertices of diffuse materials.
+// Vertices with status kFitNone or kFitFromNeighbours are not refitted (the caller fills them later
+// and labels them with propagate_material_labels).
+MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &store, const PhongFitOptions &o,
+                             const MaterialOptions &mo, const float *diffuse_rgb, const uint8_t *diffuse_valid,
+                             std::vector<VertexFit> &fits);
+
+// Gives modelled vertices without a label (e.g. filled from neighbours) the most common label of
+// their labelled neighbours, ring by ring; vertices without a model keep 0.
+void propagate_material_labels(const MeshView &mesh, const std::vector<VertexFit> &fits, std::vector<int32_t> &label);
+
+} // namespace vbrdf

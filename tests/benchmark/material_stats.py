@@ -1,0 +1,63 @@
+#!/usr/bin/python3
+"""Specular figures of a fit against a shared scene's ground truth (issue 16).
+
+  material_stats.py FIT.ply SCENE_DIR
+
+Over the ground-truth visible vertices (gt_vertex.npz `visible`): share of glossy-material vertices
+with k_s > 0; share of diffuse-material vertices with k_s below 1 % of k_d; the median fitted
+shininess (R.E) of glossy vertices with k_s > 0 against the truth (`phong_shininess_approx` is the
+N.H exponent; the R.E exponent is about a quarter of it); and the found `material` labels against
+the true `material_id` (vertex counts per pair). Needs numpy.
+"""
+import sys
+
+import numpy as np
+
+PLY_TYPES = {'float': '<f4', 'float32': '<f4', 'double': '<f8', 'uchar': 'u1', 'uint8': 'u1',
+             'int': '<i4', 'int32': '<i4', 'uint': '<u4', 'short': '<i2', 'ushort': '<u2'}
+
+
+def read_ply_vertices(path):
+    with open(path, 'rb') as f:
+        data = f.read()
+    end = data.index(b'end_header\n') + len(b'end_header\n')
+    header = data[:end].decode('ascii').splitlines()
+    count, props, in_vertex = 0, [], False
+    for line in header:
+        t = line.split()
+        if t and t[0] == 'element':
+            in_vertex = t[1] == 'vertex'
+            if in_vertex:
+                count = int(t[2])
+        elif t and t[0] == 'property' and in_vertex:
+            props.append((t[2], PLY_TYPES[t[1]]))
+    return np.frombuffer(data, np.dtype(props), count, end)
+
+
+def main():
+    fit = read_ply_vertices(sys.argv[1])
+    gt = np.load(sys.argv[2] + '/gt_vertex.npz')
+    vis = gt['visible'].astype(bool)
+    glossy = gt['is_glossy'].astype(bool)
+    ks, kd, alpha = fit['ks'], fit['kd'], fit['shininess']
+    g = vis & glossy
+    d = vis & ~glossy
+    print('glossy visible vertices with k_s > 0: %.1f %% of %d' % (100 * np.mean(ks[g] > 0), g.sum()))
+    if d.any():
+        print('diffuse visible vertices with k_s < 1 %% of k_d: %.1f %% of %d' % (100 * np.mean(ks[d] <= 0.01 * kd[d]), d.sum()))
+    sel = g & (ks > 0)
+    if sel.any():
+        truth = float(np.median(gt['phong_shininess_approx'][g]))
+        med = float(np.median(alpha[sel]))
+        print('median fitted shininess (R.E) %.1f; truth N.H %.1f, R.E about %.1f (ratio to R.E truth %.2f)'
+              % (med, truth, truth / 4, med / (truth / 4)))
+    if 'material' in fit.dtype.names:
+        lab = fit['material'].astype(int)
+        for m in np.unique(lab[vis]):
+            row = ['true %d: %d' % (t, np.sum(vis & (lab == m) & (gt['material_id'] == t)))
+                   for t in np.unique(gt['material_id'])]
+            print('found material %d: %s' % (m, ', '.join(row)))
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,173 @@
+// The material stage (materials.h): a synthetic object of two materials, a glossy half (one
+// Phong lobe) and a diffuse half, both under the same textured albedo; every vertex sees each
+// lobe at most once or twice, so per-vertex fits cannot pin it, the pooled samples can.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "fit/materials.h"
+#include "test_scenes.h"
+
+using namespace vbrdf;
+
+namespace {
+
+struct Scene {
+  MeshData mesh;
+  SampleChunk chunk;
+  std::vector<int> truth;  // 1 glossy, 2 diffuse
+};
+
+// A 31 x 31 grid whose normals fan out over +-40 degrees (a cap), 16 lights, camera along +z.
+// Vertices with x < 0 are glossy when `two_materials`, else every vertex is glossy.
+Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed) {
+  Scene sc;
+  sc.mesh = test::make_grid(30, 1.0f, 0.0f);
+  const size_t n = sc.mesh.positions.size() / 3;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::normal_distribution<float> gauss(0, 1);
+  std::vector<std::array<float, 3>> lights;
+  for (int i = 0; i < 16; ++i) {
+    const float z = 0.35f + 0.6f * float(i % 4) / 3.0f, phi = 2.39996f * float(i);
+    const float r = std::sqrt(1 - z * z);
+    lights.push_back({{r * std::cos(phi), r * std::sin(phi), z}});
+  }
+  sc.chunk.first_vertex = 0;
+  sc.chunk.vertex_count = uint32_t(n);
+  sc.chunk.offsets.push_back(0);
+  for (size_t v = 0; v < n; ++v) {
+    const float x = sc.mesh.positions[3 * v], y = sc.mesh.positions[3 * v + 2];
+    float N[3] = {0.8f * x, 0.8f * y, 1.0f};
+    const float len = std::sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+    for (float &c : N) c /= len;
+    const bool glossy = !two_materials || x < 0;
+    sc.truth.push_back(glossy ? 1 : 2);
+    const float rho[3] = {0.2f + 0.5f * u(rng), 0.2f + 0.5f * u(rng), 0.2f + 0.5f * u(rng)};  // texture
+    for (size_t l = 0; l < lights.size(); ++l) {
+      const float *L = lights[l].data();
+      const float d = N[0] * L[0] + N[1] * L[1] + N[2] * L[2];
+      const float s = 2 * d * N[2] - L[2];  // R.E with E = +z
+      Sample smp{};
+      smp.n_dot_l = d, smp.r_dot_e = s, smp.raster = uint16_t(l);
+      const float g = glossy && s > 0 && d > 0 ? ks * std::pow(s, alpha) : 0.0f;
+      for (int c = 0; c < 3; ++c) smp.rgb[c] = std::max(0.0f, (rho[c] * std::max(d, 0.0f) + g) * (1 + 0.01f * gauss(rng)));
+      smp.flags = uint16_t((d <= 0 ? kAttachedShadow : 0) | (d > 0 && d < 0.2f ? kGrazing : 0) | (s > 0.9f ? kHighlight : 0));
+      sc.chunk.samples.push_back(smp);
+    }
+    sc.chunk.offsets.push_back(uint32_t(sc.chunk.samples.size()));
+  }
+  return sc;
+}
+
+struct StageRun {
+  MaterialResult result;
+  std::vector<VertexFit> before, after;
+};
+
+StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions()) {
+  PhongFitOptions o;
+  StageRun r;
+  r.before.resize(sc.chunk.vertex_count);
+  fit_chunk_cpu(sc.chunk, o, r.before.data());
+  r.after = r.before;
+  MaterialSampleStore store(sc.chunk.vertex_count);
+  store.add_chunk(sc.chunk, r.before.data(), o);
+  r.result = fit_materials(sc.mesh.view(), store, o, mo, nullptr, nullptr, r.after);
+  return r;
+}
+
+} // namespace
+
+TEST(Materials, TwoMaterialsAndTheirLobesAreRecovered) {
+  const float ks = 0.5f, alpha = 30.0f;
+  const Scene sc = make_scene(true, ks, alpha, 7);
+  MaterialOptions everywhere;
+  everywhere.keep_full_fits = false;  // every glossy vertex takes the material-regularised lobe
+  const StageRun r = run_stage(sc, everywhere);
+  ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
+  ASSERT_EQ(r.result.materials.size(), 2u);
+  // Which found material is the glossy one: the one holding most truly glossy vertices.
+  size_t agree[3][3] = {};
+  for (size_t v = 0; v < sc.truth.size(); ++v) ++agree[sc.truth[v]][size_t(r.result.label[v])];
+  const int glossy = agree[1][1] >= agree[1][2] ? 1 : 2, diffuse = 3 - glossy;
+  const double correct = double(agree[1][size_t(glossy)] + agree[2][size_t(diffuse)]) / double(sc.truth.size());
+  EXPECT_GE(correct, 0.95) << r.result.report;
+  const Material &g = r.result.materials[size_t(glossy) - 1], &d = r.result.materials[size_t(diffuse) - 1];
+  EXPECT_FALSE(g.diffuse);
+  EXPECT_TRUE(d.diffuse) << r.result.report;
+  EXPECT_NEAR(g.shininess, alpha, 0.1 * alpha) << r.result.report;
+  EXPECT_NEAR(g.ks, ks, 0.1 * ks) << r.result.report;
+  // Every vertex of the glossy material has a lobe, every one of the diffuse material none; the
+  // per-vertex fit alone left many glossy vertices without one.
+  size_t glossy_n = 0, glossy_ks = 0, glossy_ks_before = 0, diffuse_n = 0, diffuse_ks0 = 0;
+  for (size_t v = 0; v < sc.truth.size(); ++v) {
+    if (r.result.label[v] == glossy) {
+      ++glossy_n, glossy_ks += r.after[v].ks > 0, glossy_ks_before += r.before[v].ks > 0;
+      // The vertex's alpha is its material's, or regularised towards it within a factor of 4.
+      EXPECT_GE(r.after[v].shininess, 0.25f * float(g.shininess) * 0.999f);
+      EXPECT_LE(r.after[v].shininess, 4.0f * float(g.shininess) * 1.001f);
+    } else {
+      ++diffuse_n, diffuse_ks0 += r.after[v].ks == 0;
+    }
+    for (float c : r.after[v].color) EXPECT_TRUE(std::isfinite(c));
+    EXPECT_TRUE(std::isfinite(r.after[v].kd) && std::isfinite(r.after[v].ks) && std::isfinite(r.after[v].rmse));
+  }
+  EXPECT_EQ(glossy_ks, glossy_n);
+  EXPECT_EQ(diffuse_ks0, diffuse_n);
+  // The case the stage exists for: the per-vertex fits' exponents scatter far more than the pooled one's error.
+  std::vector<double> alpha_err;
+  for (size_t v = 0; v < sc.truth.size(); ++v)
+    if (sc.truth[v] == 1 && r.before[v].ks > 0) alpha_err.push_back(std::fabs(r.before[v].shininess - alpha) / alpha);
+  ASSERT_FALSE(alpha_err.empty());
+  std::nth_element(alpha_err.begin(), alpha_err.begin() + long(alpha_err.size() / 2), alpha_err.end());
+  const double per_vertex_median = alpha_err[alpha_err.size() / 2];
+  EXPECT_LT(std::fabs(g.shininess - alpha) / alpha, 0.5 * per_vertex_median)
+      << "per-vertex alpha median error " << per_vertex_median << ", glossy vertices with k_s > 0 before: "
+      << glossy_ks_before << " of " << glossy_n;
+}
+
+TEST(Materials, OneGlossyMaterialIsOneMaterial) {
+  const Scene sc = make_scene(false, 0.4f, 60.0f, 11);
+  const StageRun r = run_stage(sc);
+  ASSERT_EQ(r.result.chosen_k, 1) << r.result.report;
+  EXPECT_FALSE(r.result.materials[0].diffuse);
+  EXPECT_NEAR(r.result.materials[0].shininess, 60.0, 6.0) << r.result.report;
+  for (size_t v = 0; v < sc.truth.size(); ++v) EXPECT_GT(r.after[v].ks, 0.0f);
+}
+
+TEST(Materials, NoSamplesLeaveTheFitsAlone) {
+  const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
+  std::vector<VertexFit> fits(mesh.positions.size() / 3, VertexFit{{0, 0, 0}, 0, 0, 0, 0, 0, 0, 0, kFitNone, 0});
+  MaterialSampleStore store(fits.size());
+  const MaterialResult r = fit_materials(mesh.view(), store, PhongFitOptions(), MaterialOptions(), nullptr, nullptr, fits);
+  EXPECT_EQ(r.chosen_k, 0);
+  for (int32_t l : r.label) EXPECT_EQ(l, 0);
+}
+
+TEST(Materials, ByDefaultOwnLobesAreKeptAndTheOthersGetTheMaterials) {
+  const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
+  const StageRun r = run_stage(sc);
+  ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
+  size_t kept = 0, given = 0;
+  for (size_t v = 0; v < sc.truth.size(); ++v) {
+    const Material &m = r.result.materials[size_t(r.result.label[v]) - 1];
+    if (m.diffuse) {
+      EXPECT_EQ(r.after[v].ks, 0.0f);
+    } else if (r.before[v].status == kFitFull && r.before[v].ks > 0) {
+      EXPECT_EQ(r.after[v].ks, r.before[v].ks);
+      EXPECT_EQ(r.after[v].shininess, r.before[v].shininess);
+      ++kept;
+    } else {
+      EXPECT_GT(r.after[v].ks, 0.0f);
+      EXPECT_NEAR(r.after[v].shininess, m.shininess, 3.0 * m.shininess);
+      ++given;
+    }
+  }
+  EXPECT_GT(kept, 0u);
+  EXPECT_GT(kept + given, sc.truth.size() / 3);
+}
