@@ -9,29 +9,17 @@ shininess (R.E) of glossy vertices with k_s > 0 against the truth (`phong_shinin
 N.H exponent; the R.E exponent is about a quarter of it); and the found `material` labels against
 the true `material_id` (vertex counts per pair). Needs numpy.
 """
+import os
 import sys
 
 import numpy as np
 
-PLY_TYPES = {'float': '<f4', 'float32': '<f4', 'double': '<f8', 'uchar': 'u1', 'uint8': 'u1',
-             'int': '<i4', 'int32': '<i4', 'uint': '<u4', 'short': '<i2', 'ushort': '<u2'}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'e2e'))
+import e2e_lib  # noqa: E402  (the project's one PLY reader for scripts)
 
 
 def read_ply_vertices(path):
-    with open(path, 'rb') as f:
-        data = f.read()
-    end = data.index(b'end_header\n') + len(b'end_header\n')
-    header = data[:end].decode('ascii').splitlines()
-    count, props, in_vertex = 0, [], False
-    for line in header:
-        t = line.split()
-        if t and t[0] == 'element':
-            in_vertex = t[1] == 'vertex'
-            if in_vertex:
-                count = int(t[2])
-        elif t and t[0] == 'property' and in_vertex:
-            props.append((t[2], PLY_TYPES[t[1]]))
-    return np.frombuffer(data, np.dtype(props), count, end)
+    return e2e_lib.read_ply(path).vertex
 
 
 def main():
