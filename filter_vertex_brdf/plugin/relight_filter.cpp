@@ -173,9 +173,8 @@ void render_novel_view(vbrdf::RelightRenderer &renderer, const RasterSet &set, c
   const vbrdf::Raster &base = set.rasters[size_t(s.view_raster)];
   if (!vbrdf::shot_is_valid(base.shot))
     throw vbrdf::InputError("Raster '" + base.label + "' has no valid camera: choose another 'viewRaster'.");
-  const vbrdf::Bounds b = vbrdf::compute_bounds(mesh.view());
-  const float pivot[3] = {0.5f * (b.min[0] + b.max[0]), 0.5f * (b.min[1] + b.max[1]), 0.5f * (b.min[2] + b.max[2])};
-  const vbrdf::Shot shot = vbrdf::orbit_shot(base.shot, pivot, s.azimuth, s.elevation, s.distance_scale);
+  const std::array<float, 3> pivot = vbrdf::compute_bounds(mesh.view()).centre();
+  const vbrdf::Shot shot = vbrdf::orbit_shot(base.shot, pivot.data(), s.azimuth, s.elevation, s.distance_scale);
   std::array<float, 3> light_world;
   vbrdf::camera_to_world_direction(shot, s.novel_light, light_world.data());
   const vbrdf::RelitImage image = renderer.render(shot, vbrdf::LightSource::directional(light_world));
@@ -284,7 +283,7 @@ void RelightFilter::apply(FilterRun &run) const {
                               "of the rendered rasters.");
     const vbrdf::MeshView view = arrays.data.view();
     lights = vbrdf::resolve_lights(set.rasters, set.light_file,
-                                   vbrdf::light_placement_of(view.positions, view.vertex_count, s.dome_radius, s.light_unit_scale));
+                                   vbrdf::light_placement_of(view, s.dome_radius, s.light_unit_scale));
   }
 
   GlContextScope gl(run.gl_context, log);

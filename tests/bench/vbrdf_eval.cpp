@@ -168,7 +168,7 @@ int main(int argc, char **argv) {
     const std::vector<VertexFit> fits = fits_from_result(result, result_path);
     const MeshView mesh_view = result.mesh.view();
     const LightPlacement placement =
-        light_placement_of(mesh_view.positions, mesh_view.vertex_count, dome_radius, light_unit_scale);
+        light_placement_of(mesh_view, dome_radius, light_unit_scale);
     const Photos heldout = load_photos(mlp, lp, photo_dir, placement);
     Photos training;
     RelightOptions options;

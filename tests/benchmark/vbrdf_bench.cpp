@@ -273,7 +273,7 @@ HeldOut load_heldout(const Args &a, const MeshData &mesh) {
   Project p = read_project(a.get("heldout"));
   const std::string lp = a.get("heldout-lp").empty() ? default_lp(p) : a.get("heldout-lp");
   const MeshView view = mesh.view();
-  h.lights = resolve_lights(p.rasters, lp, light_placement_of(view.positions, view.vertex_count, 0.0f, 0.0f));
+  h.lights = resolve_lights(p.rasters, lp, light_placement_of(view, 0.0f, 0.0f));
   use_photo_dir(p.rasters, a.get("heldout-photo-dir"));
   h.rasters = p.rasters;
   return h;
@@ -387,7 +387,7 @@ int cmd_fit(const Args &a) {
   if (!a.get("heldout").empty())
     evaluate_heldout(a, mesh, r.fits, input.rasters,
                      resolve_lights(input.rasters, r.light_file,
-                                    light_placement_of(mesh.view().positions, mesh.view().vertex_count, 0.0f, 0.0f)),
+                                    light_placement_of(mesh.view(), 0.0f, 0.0f)),
                      get_proc, out);
   if (!a.get("gt").empty()) {
     std::vector<float> n_specular;

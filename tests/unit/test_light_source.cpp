@@ -31,7 +31,10 @@ struct Capture {
       rasters.push_back(r);
     }
     const float corners[6] = {-1, -1, -1, 1, 1, 1};
-    placement = light_placement_of(corners, 2, 0, 0);
+    MeshView cube;
+    cube.positions = corners;
+    cube.vertex_count = 2;
+    placement = light_placement_of(cube, 0, 0);
   }
   std::string write(const std::string &name, const std::string &text) const {
     const std::string path = dir + "/" + name;

@@ -13,6 +13,11 @@ float Bounds::diagonal() const {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+std::array<float, 3> Bounds::centre() const {
+  if (min[0] > max[0]) return {{0, 0, 0}};
+  return {{0.5f * (min[0] + max[0]), 0.5f * (min[1] + max[1]), 0.5f * (min[2] + max[2])}};
+}
+
 Bounds compute_bounds(const MeshView &mesh) {
   Bounds b;
   for (size_t v = 0; v < mesh.vertex_count; ++v)

@@ -1,6 +1,7 @@
 #pragma once
 // A read-only view of a triangle mesh as plain arrays owned by the caller (the plugin maps CMeshO
 // onto it, tests and tools build it from vectors). Positions and normals are xyz float triples.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -39,6 +40,7 @@ struct Bounds {
   float min[3] = {1e30f, 1e30f, 1e30f};
   float max[3] = {-1e30f, -1e30f, -1e30f};
   float diagonal() const;
+  std::array<float, 3> centre() const;  // (0, 0, 0) for an empty mesh
 };
 Bounds compute_bounds(const MeshView &mesh);
 

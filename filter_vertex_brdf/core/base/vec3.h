@@ -34,9 +34,6 @@ inline T normalize3(T *v) {
   return n;
 }
 
-// "12.3%" for percent(123, 1000): shares in reports ("0%" when `whole` is 0).
-inline std::string percent(double part, double whole);
-
 // "1.23" for fixed(1.234, 2): the number format of the reports and logs.
 inline std::string fixed(double v, int digits = 2) {
   std::ostringstream s;
@@ -46,6 +43,7 @@ inline std::string fixed(double v, int digits = 2) {
   return s.str();
 }
 
+// "12.3%" for percent(123, 1000): shares in reports ("0%" when `whole` is 0).
 inline std::string percent(double part, double whole) {
   return whole > 0 ? fixed(100.0 * part / whole, 1) + "%" : "0%";
 }

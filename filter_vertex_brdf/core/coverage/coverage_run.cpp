@@ -423,7 +423,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   // files (.json, .dome) and a dome radius go through the fit's resolve_lights.
   std::vector<std::string> unused;
   const LightPlacement placement =
-      light_placement_of(mesh.positions, mesh.vertex_count, settings.dome_radius, settings.light_unit_scale);
+      light_placement_of(mesh, settings.dome_radius, settings.light_unit_scale);
   const bool plain_lp = placement.dome_radius <= 0 && extension_of(r.light_file) == "lp";
   const std::vector<LightSource> sources =
       plain_lp ? directional_lights(lights_for_rasters(input.rasters, r.light_file, &unused))

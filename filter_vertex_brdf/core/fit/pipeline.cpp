@@ -399,7 +399,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
                      why);
   }
   const LightPlacement placement =
-      light_placement_of(mesh.positions, mesh.vertex_count, settings.dome_radius, settings.light_unit_scale);
+      light_placement_of(mesh, settings.dome_radius, settings.light_unit_scale);
   const std::vector<LightSource> lights = resolve_lights(input.rasters, result.light_file, placement);
   result.light_model = describe_lights(lights, placement);
   log("Lights: " + result.light_model + ", from '" + result.light_file + "'.");

@@ -39,7 +39,8 @@ GlMeshFrame gl_mesh_frame(const MeshView &mesh, float depth_tolerance_fraction, 
   const Bounds b = compute_bounds(mesh);
   f.tolerance = depth_tolerance_fraction * b.diagonal();
   if (mesh.vertex_count == 0) return f;
-  for (int k = 0; k < 3; ++k) f.origin[k] = 0.5f * (b.min[k] + b.max[k]);
+  const std::array<float, 3> centre = b.centre();
+  for (int k = 0; k < 3; ++k) f.origin[k] = centre[size_t(k)];
   for (int c = 0; c < 8; ++c)
     for (int k = 0; k < 3; ++k) f.corners[c][k] = ((c >> k) & 1 ? b.max[k] : b.min[k]) - f.origin[k];
   float r2 = 0;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include <opencv2/core.hpp>
@@ -19,21 +18,11 @@ using Vec3 = std::array<float, 3>;
 
 float length3(const Vec3 &v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
-Vec3 box_centre(const LightPlacement &p) {
-  return {{0.5f * (p.box_min[0] + p.box_max[0]), 0.5f * (p.box_min[1] + p.box_max[1]),
-           0.5f * (p.box_min[2] + p.box_max[2])}};
-}
-
-float box_diagonal(const LightPlacement &p) {
-  const Vec3 d{{p.box_max[0] - p.box_min[0], p.box_max[1] - p.box_min[1], p.box_max[2] - p.box_min[2]}};
-  return length3(d);
-}
-
 // Distance from q to the box (0 inside).
 float distance_to_box(const LightPlacement &p, const Vec3 &q) {
   float s = 0;
   for (int k = 0; k < 3; ++k) {
-    const float d = std::max({p.box_min[k] - q[k], 0.0f, q[k] - p.box_max[k]});
+    const float d = std::max({p.box.min[k] - q[k], 0.0f, q[k] - p.box.max[k]});
     s += d * d;
   }
   return std::sqrt(s);
@@ -44,7 +33,7 @@ LightSource point_light(const Vec3 &position, const LightPlacement &placement, f
   l.positional = true;
   l.position = position;
   l.intensity = intensity;
-  const Vec3 c = box_centre(placement);
+  const Vec3 c = placement.box.centre();
   Vec3 d{{position[0] - c[0], position[1] - c[1], position[2] - c[2]}};
   const float len = length3(d);
   if (len > 0)
@@ -71,19 +60,11 @@ Vec3 camera_to_world_point(const Shot &shot, const Vec3 &p_cam) {
   return {{c[0] + len * dir[0], c[1] + len * dir[1], c[2] + len * dir[2]}};
 }
 
-std::string read_text(const std::string &path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("Cannot open light file '" + path + "': check the path given in 'lightFile'.");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 cv::FileStorage open_json(const std::string &path) {
-  const std::string text = read_text(path);
+  if (!file_exists(path)) throw InputError("Cannot open light file '" + path + "': check the path given in 'lightFile'.");
   cv::FileStorage fs;
   try {
-    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_JSON);
+    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_JSON);  // .dome too: JSON whatever the name
   } catch (const cv::Exception &e) {
     throw InputError("Light file '" + path + "' is not valid JSON (" + e.err + "): fix it or export it again.");
   }
@@ -143,7 +124,7 @@ std::vector<LightSource> from_lp(const std::vector<Raster> &rasters, const std::
   for (const LightEntry &e : entries) images.push_back(e.image);
   const std::vector<size_t> index = match_entries(rasters, images, path);
   std::vector<LightSource> lights(rasters.size());
-  const Vec3 c = box_centre(placement);
+  const Vec3 c = placement.box.centre();
   for (size_t r = 0; r < rasters.size(); ++r) {
     Vec3 d;
     camera_to_world_direction(rasters[r].shot, entries[index[r]].dir_cam, d.data());
@@ -204,7 +185,7 @@ std::vector<LightSource> from_json(const std::vector<Raster> &rasters, const std
 
 // Relight's frame for raster r: origin on the optical axis at the depth of the box centre.
 Vec3 relight_frame_to_world(const Shot &shot, const Vec3 &p_cm, float scale, const LightPlacement &placement) {
-  const Vec3 c = box_centre(placement);
+  const Vec3 c = placement.box.centre();
   const float depth = view_depth(shot, c.data());
   const Vec3 p{{p_cm[0] * scale, p_cm[1] * scale, p_cm[2] * scale - depth}};  // camera frame, z towards viewer
   return camera_to_world_point(shot, p);
@@ -316,16 +297,9 @@ std::vector<std::array<float, 3>> light_directions(const std::vector<LightSource
   return d;
 }
 
-LightPlacement light_placement_of(const float *positions, size_t vertex_count, float dome_radius, float unit_scale) {
+LightPlacement light_placement_of(const MeshView &mesh, float dome_radius, float unit_scale) {
   LightPlacement p;
-  if (vertex_count > 0) {
-    for (int k = 0; k < 3; ++k) p.box_min[k] = p.box_max[k] = positions[k];
-    for (size_t v = 1; v < vertex_count; ++v)
-      for (int k = 0; k < 3; ++k) {
-        p.box_min[k] = std::min(p.box_min[k], positions[3 * v + k]);
-        p.box_max[k] = std::max(p.box_max[k], positions[3 * v + k]);
-      }
-  }
+  p.box = compute_bounds(mesh);
   p.dome_radius = dome_radius;
   p.unit_scale = unit_scale;
   return p;
@@ -370,7 +344,7 @@ void write_light_positions(const std::string &path, const std::vector<std::strin
 
 void check_light_positions(const std::vector<LightSource> &lights, const std::vector<Raster> &rasters,
                            const LightPlacement &placement, const std::string &path) {
-  const float half_diagonal = 0.5f * box_diagonal(placement);
+  const float half_diagonal = 0.5f * placement.box.diagonal();
   for (size_t r = 0; r < lights.size(); ++r) {
     const LightSource &l = lights[r];
     if (!l.positional) continue;
@@ -393,7 +367,7 @@ void check_light_positions(const std::vector<LightSource> &lights, const std::ve
 }
 
 void set_reference_distance(std::vector<LightSource> &lights, const LightPlacement &placement) {
-  const Vec3 c = box_centre(placement);
+  const Vec3 c = placement.box.centre();
   std::vector<float> distances;
   for (const LightSource &l : lights)
     if (l.positional)
@@ -424,8 +398,8 @@ std::string describe_lights(const std::vector<LightSource> &lights, const LightP
   std::ostringstream s;
   size_t points = 0;
   float dmin = 1e30f, dmax = 0, subtended = 0;
-  const Vec3 c = box_centre(placement);
-  const float half = 0.5f * box_diagonal(placement);
+  const Vec3 c = placement.box.centre();
+  const float half = 0.5f * placement.box.diagonal();
   for (const LightSource &l : lights) {
     if (!l.positional) continue;
     ++points;

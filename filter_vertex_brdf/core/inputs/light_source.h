@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "base/mesh_view.h"
 #include "inputs/camera.h"
 
 namespace vbrdf {
@@ -48,7 +49,7 @@ std::vector<std::array<float, 3>> light_directions(const std::vector<LightSource
 
 // Where the object is, to place lights given relative to it and to check positions.
 struct LightPlacement {
-  float box_min[3] = {0, 0, 0}, box_max[3] = {0, 0, 0};  // the mesh's bounding box (world)
+  Bounds box;  // the mesh's bounding box (world); empty (no mesh) only serves directional .lp files
   // > 0: directions from an .lp become point lights on a dome of this radius (mesh units) around
   // the bounding box's centre. 0: directions stay directional.
   float dome_radius = 0;
@@ -59,7 +60,7 @@ struct LightPlacement {
 };
 
 // The placement of a mesh: its bounding box, dome radius and unit scale as given.
-LightPlacement light_placement_of(const float *positions, size_t vertex_count, float dome_radius, float unit_scale);
+LightPlacement light_placement_of(const MeshView &mesh, float dome_radius, float unit_scale);
 
 // Reads the lights of every raster from `path`, in one of three forms (README "Lights"):
 //  - RTI .lp (RTIBuilder / Relight): per photo a direction in its camera frame. Directional, or

@@ -112,6 +112,10 @@ public:
 private:
   // True when a triangle lies on the ray from `from` along unit `dir` within (0, max_dist].
   bool blocked(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist);
+  // True when a triangle lies between vertex position `pos` and the point `target` (a camera
+  // centre, a point light): the segment starts `tolerance_` off the vertex and stops at the target
+  // (geometry beyond it is not in the way). A target within the tolerance is not blocked.
+  bool blocked_towards(MarkState &marks, const vcg::Point3f &pos, const vcg::Point3f &target);
   // vcglib's grid walk misses hits on rays that start outside the grid's box (e.g. above a flat
   // mesh): such rays are started where they enter the box, just inside it. False when the ray
   // misses the box within max_dist; `skipped` is the distance moved.
@@ -179,6 +183,14 @@ bool CpuVisibility::blocked(MarkState &marks, const vcg::Point3f &from, const vc
   return first_hit(marks, from, dir, max_dist) < std::numeric_limits<float>::infinity();
 }
 
+bool CpuVisibility::blocked_towards(MarkState &marks, const vcg::Point3f &pos, const vcg::Point3f &target) {
+  vcg::Point3f dir = target - pos;
+  const float dist = dir.Norm();
+  if (!(dist > tolerance_)) return false;
+  dir /= dist;
+  return blocked(marks, pos + dir * tolerance_, dir, dist - tolerance_);
+}
+
 float CpuVisibility::first_hit(MarkState &marks, const vcg::Point3f &from, const vcg::Point3f &dir, float max_dist) {
   const float none = std::numeric_limits<float>::infinity();
   if (triangles_.empty() || !(max_dist > 0)) return none;
@@ -243,12 +255,7 @@ void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
         out[v] = 1;
         continue;
       }
-      const vcg::Point3f pos(p[0], p[1], p[2]);
-      vcg::Point3f dir = centre - pos;
-      const float dist = dir.Norm();
-      dir /= dist;
-      // Segment from the offset start to the camera centre.
-      if (blocked(marks, pos + dir * tolerance_, dir, dist - tolerance_)) {
+      if (blocked_towards(marks, vcg::Point3f(p[0], p[1], p[2]), centre)) {
         out[v] = kCameraHidden;
         continue;
       }
@@ -258,19 +265,29 @@ void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
 }
 
 void CpuVisibility::light_pass(const LightSource &light, uint8_t *out) {
-  const float *dir_world = light.direction.data();
-  vcg::Point3f dir(dir_world[0], dir_world[1], dir_world[2]);
-  const float len = dir.Norm();
-  if (!light.positional && (!(len > 1e-12f) || !std::isfinite(len)))
-    throw InputError("CPU visibility: the light direction is zero or not finite.");
-  if (light.positional)
+  const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
+  if (light.positional) {  // segments towards the light, stopping there
     for (float c : light.position)
       if (!std::isfinite(c)) throw InputError("CPU visibility: the light position is not finite.");
-  if (!light.positional) dir /= len;
+    const vcg::Point3f light_pos(light.position[0], light.position[1], light.position[2]);
+#pragma omp parallel
+    {
+      MarkState marks;
+      marks.stamps.assign(triangles_.size(), 0u);
+#pragma omp for schedule(dynamic, 256)
+      for (ptrdiff_t v = 0; v < n; ++v) {
+        const float *p = mesh_.positions + 3 * v;
+        out[v] = blocked_towards(marks, vcg::Point3f(p[0], p[1], p[2]), light_pos) ? 0 : 1;
+      }
+    }
+    return;
+  }
+  vcg::Point3f dir(light.direction[0], light.direction[1], light.direction[2]);
+  const float len = dir.Norm();
+  if (!(len > 1e-12f) || !std::isfinite(len)) throw InputError("CPU visibility: the light direction is zero or not finite.");
+  dir /= len;
   // Any occluder lies within the bounding box, hence within one diagonal of the vertex.
   const float max_dist = 2 * diagonal_ + tolerance_;
-  const vcg::Point3f light_pos(light.position[0], light.position[1], light.position[2]);
-  const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
 #pragma omp parallel
   {
     MarkState marks;
@@ -279,19 +296,7 @@ void CpuVisibility::light_pass(const LightSource &light, uint8_t *out) {
     for (ptrdiff_t v = 0; v < n; ++v) {
       const float *p = mesh_.positions + 3 * v;
       const vcg::Point3f pos(p[0], p[1], p[2]);
-      if (!light.positional) {
-        out[v] = blocked(marks, pos + dir * tolerance_, dir, max_dist) ? 0 : 1;
-        continue;
-      }
-      // Towards the point light, up to it (geometry beyond the light casts no shadow).
-      vcg::Point3f to_light = light_pos - pos;
-      const float dist = to_light.Norm();
-      if (!(dist > tolerance_)) {
-        out[v] = 1;
-        continue;
-      }
-      to_light /= dist;
-      out[v] = blocked(marks, pos + to_light * tolerance_, to_light, std::min(dist, max_dist) - tolerance_) ? 0 : 1;
+      out[v] = blocked(marks, pos + dir * tolerance_, dir, max_dist) ? 0 : 1;
     }
   }
 }
