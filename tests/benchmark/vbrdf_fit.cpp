@@ -1,6 +1,6 @@
 // vbrdf_fit: runs the filter's core pipeline on a .mlp without MeshLab (GL through OSMesa).
 //   vbrdf_fit project.mlp [--lp lights.lp|.json|.dome] [--dome-radius R] [--light-unit-scale S] [--out result.ply] [--visibility auto|gl|cpu]
-//             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048]
+//             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048] [--depth-tests gpu|cpu]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
@@ -25,7 +25,7 @@ using namespace vbrdf;
 namespace {
 int usage() {
   std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--dome-radius R] [--light-unit-scale S] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
-               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--fit auto|gpu|cpu|off]\n"
+               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--depth-tests gpu|cpu] [--fit auto|gpu|cpu|off]\n"
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n";
@@ -47,6 +47,7 @@ int main(int argc, char **argv) {
     else if (a == "--ts") settings.gather.specular_threshold = std::stof(next());
     else if (a == "--td") settings.gather.diffuse_threshold = std::stof(next());
     else if (a == "--shadow-map") settings.visibility.shadow_map_size = std::stoi(next());
+    else if (a == "--depth-tests") settings.visibility.depth_tests_on_gpu = next() != "cpu";  // gpu (default) | cpu
     else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
     else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());

@@ -16,6 +16,7 @@
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "inputs/light_file.h"
+#include "inputs/photo_prefetch.h"
 #include "io/coverage_outputs.h"
 #include "base/vec3.h"
 #include "coverage/coverage_geometry.h"
@@ -234,12 +235,13 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
       (unused.empty() ? std::string(".") : " (" + std::to_string(unused.size()) + " entries for photos not imported yet)."));
 
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
-  for (const Raster &raster : input.rasters) photos.get(raster.image_path, raster.width(), raster.height());
+  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);  // as the fit
 
   auto t = Clock::now();
   const VisibilityMasks masks = compute_visibility(mesh, input.rasters, sources, visibility,
                                                    [&](float f, const char *s) { return !progress || progress(0.45f * f, s); });
   r.seconds_visibility = seconds_since(t);
+  prefetch->finish();
 
   t = Clock::now();
   r.counts.assign(n, CoverageCounts());

@@ -55,35 +55,6 @@ struct Slot {
   bool pending = false;           // dispatched, not yet read back
 };
 
-// Saves and restores the SSBO bindings the pass uses (GlStateGuard does not cover them).
-class SsboBindingGuard {
-public:
-  explicit SsboBindingGuard(const GlApi &gl) : gl_(gl) {
-    gl.GetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
-    for (GLuint i = 0; i < kCount; ++i) {
-      gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &buffer_[i]);
-      gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_START, i, &start_[i]);
-      gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_SIZE, i, &size_[i]);
-    }
-  }
-  ~SsboBindingGuard() {
-    for (GLuint i = 0; i < kCount; ++i) {
-      if (buffer_[i] && size_[i] > 0)
-        gl_.BindBufferRange(GL_SHADER_STORAGE_BUFFER, i, GLuint(buffer_[i]), start_[i], size_[i]);
-      else
-        gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(buffer_[i]));
-    }
-    gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(generic_));
-  }
-  SsboBindingGuard(const SsboBindingGuard &) = delete;
-  SsboBindingGuard &operator=(const SsboBindingGuard &) = delete;
-
-private:
-  static constexpr GLuint kCount = 4;  // bindings 0..3
-  const GlApi &gl_;
-  GLint generic_ = 0, buffer_[kCount] = {}, start_[kCount] = {}, size_[kCount] = {};
-};
-
 // Throws unless the chunk's CSR arrays are consistent: the shader trusts them for its loop bounds.
 void validate_chunk(const SampleChunk &chunk) {
   if (chunk.offsets.size() != size_t(chunk.vertex_count) + 1)

@@ -11,6 +11,7 @@
 #include "calibration/color_plan.h"
 #include "inputs/light_file.h"
 #include "inputs/light_source.h"
+#include "inputs/photo_prefetch.h"
 #include "io/fit_outputs.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
@@ -159,9 +160,10 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
     if (!protected_path.empty() && result.output_ply == protected_path)
       throw InputError("The output '" + result.output_ply + "' would overwrite an input file: choose another 'outputPly'.");
 
-  // Photos are validated (size, bit depth) before the long passes start.
+  // The photos decode in the background while the GL passes run (photo_prefetch.h); a photo that
+  // cannot be decoded fails before any sample is gathered, so before anything is written.
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
-  for (const Raster &r : input.rasters) photos.get(r.image_path, r.width(), r.height());
+  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);
   // Before the long passes: a required chart that is missing fails early.
   if (progress) progress(0.0f, "colour calibration");
   ColorPlan colors = plan_colors(input, settings, light_directions(lights), photos, log);
@@ -173,6 +175,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
   const VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
   result.seconds_visibility = seconds_since(t);
+  prefetch->finish();
 
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
