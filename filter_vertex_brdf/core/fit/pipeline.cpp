@@ -244,6 +244,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
       rec.fit = f;
+      rec.lobe_form = float(uint8_t(settings.phong.lobe));
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -296,6 +297,10 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   for (size_t i = 0; i < input.rasters.size(); ++i)
     if (g.raster_seen_vertices[i] == 0)
       rep << "skipped: raster '" << input.rasters[i].label << "' sees no vertex (check its registration); its photo was not read\n";
+  if (settings.fit_reflectance)
+    rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
+        << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
+        << "); samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off") << "\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
@@ -379,6 +384,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   validate_input(input);
   FitSettings settings = settings_in;
   settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
+  settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
   if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
   const MeshView &mesh = input.mesh;
   FitResult result;
