@@ -101,7 +101,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   params.addParam(RichFloat(kInitialShininess, vbrdf::PhongFitOptions().alpha_init, "Initial shininess",
                             "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
                             "the highlight samples and keeps the better one). Range [1, 2000]."));
-  params.addParam(RichEnum(kSpecularLobe, int(vbrdf::PhongFitOptions().lobe),
+  params.addParam(RichEnum(kSpecularLobe, int(vbrdf::kFitLobe),
                            QStringList() << "Phong on R.E (thesis)" << "Blinn-Phong on N.H",
                            "Specular lobe",
                            "What the shininess is the exponent of: the cosine between the mirrored light and "

@@ -10,6 +10,7 @@
 #   (b) over those that every fit models ("common": fit_status != 0 in each), the protocol.
 #   tests/benchmark/cross_camera_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_fit OPTIONS...]
 #   environment: VBRDF_SHARED_DIR (default <repo>/../shared), CAMERAS (default "spot_dir24 spot_dir24_view2"),
+#   SETS (default "all common": the vertex sets scored),
 #   CHECK_TOLERANCE (e.g. 0.05): only the "common" rows of each camera's own fit and of "both" at
 #   that camera are scored, and the script fails (exit 1) when "both" is worse than the camera's
 #   own fit by more than that fraction (whole-surface mean): adding a camera's photos must not
@@ -86,7 +87,7 @@ for c in cams:
     open(f"{work}/{c}/gt_common.ply", 'wb').write(head + v.tobytes() + rest)
 PY
 check=${CHECK_TOLERANCE:-}
-sets="all common"
+sets=${SETS:-"all common"}
 [ -n "$check" ] && sets=common
 status=0
 for f in $cameras both; do

@@ -92,8 +92,9 @@ struct GatherSettings {
   // (pipeline.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
   LobeForm lobe = LobeForm::PhongRE;
   // Weight samples by their photo's resolution of the vertex (Sample::resolution); false: every
-  // code 0 (all photos alike).
-  bool resolution_weights = true;
+  // code 0 (all photos alike). Off by default: on the spot pair the two-camera fit scored worse
+  // with it (README "The lobe's form and several cameras").
+  bool resolution_weights = false;
 };
 
 // Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
