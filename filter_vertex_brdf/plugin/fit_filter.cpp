@@ -19,6 +19,7 @@ const char *const kOutputPly = "outputPly";
 const char *const kFitReflectance = "fitReflectance";
 const char *const kFitBackend = "fitBackend";
 const char *const kInitialShininess = "initialShininess";
+const char *const kSpecularLobe = "specularLobe";
 const char *const kMaxIterations = "maxIterations";
 const char *const kFillUnseenRings = "fillUnseenRings";
 const char *const kQualityOutput = "qualityOutput";
@@ -100,6 +101,14 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   params.addParam(RichFloat(kInitialShininess, vbrdf::PhongFitOptions().alpha_init, "Initial shininess",
                             "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
                             "the highlight samples and keeps the better one). Range [1, 2000]."));
+  params.addParam(RichEnum(kSpecularLobe, int(vbrdf::kFitLobe),
+                           QStringList() << "Phong on R.E (thesis)" << "Blinn-Phong on N.H",
+                           "Specular lobe",
+                           "What the shininess is the exponent of: the cosine between the mirrored light and "
+                           "the view (R.E, the thesis's Phong) or between the normal and the half vector "
+                           "(N.H, Blinn-Phong; follows glossy highlights seen away from the camera axis "
+                           "better). Written with the result (per-vertex lobe_form) and used by every "
+                           "later step (relighting, evaluation)."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
@@ -134,6 +143,8 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(iterations >= 0 && iterations <= 10000, kMaxIterations, "must be in [0, 10000]");
   const int fill_rings = params.getInt(kFillUnseenRings);
   require(fill_rings >= 0 && fill_rings <= 1000, kFillUnseenRings, "must be in [0, 1000]");
+  const int lobe = params.getEnum(kSpecularLobe);
+  require(lobe >= 0 && lobe <= 1, kSpecularLobe, "must be 0 (Phong on R.E) or 1 (Blinn-Phong on N.H)");
   const int quality = params.getEnum(kQualityOutput);
   require(quality >= 0 && quality <= 2, kQualityOutput, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
 
@@ -141,6 +152,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.fit_backend = vbrdf::FitBackendChoice(fit_backend);
   s.phong.alpha_init = alpha0;
   s.phong.max_iterations = iterations;
+  s.phong.lobe = vbrdf::LobeForm(lobe);
   s.phong.min_specular_samples = shared::min_specular_samples(params);
   s.fill_unseen_rings = fill_rings;
   s.quality = vbrdf::QualityOutput(quality);

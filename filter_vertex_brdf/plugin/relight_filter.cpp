@@ -78,7 +78,7 @@ RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &pa
 namespace {
 
 // The fit filter's per-vertex float attributes, read by name through the result schema.
-std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays) {
+std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays, vbrdf::LobeForm &lobe) {
   using Alloc = vcg::tri::Allocator<CMeshO>;
   vbrdf::ResultColumns columns;
   for (const vbrdf::ResultAttribute &a : vbrdf::result_schema()) {
@@ -93,13 +93,14 @@ std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &
                             "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit Phong reflectance' on) "
                             "first, or set 'fitResultPly' to the PLY it wrote.");
   std::vector<vbrdf::VertexFit> fits;
-  for (const vbrdf::VertexRecord &record : vbrdf::records_from_columns(columns, utf8(mesh.label())))
-    fits.push_back(record.fit);
+  const std::vector<vbrdf::VertexRecord> records = vbrdf::records_from_columns(columns, utf8(mesh.label()));
+  for (const vbrdf::VertexRecord &record : records) fits.push_back(record.fit);
+  lobe = vbrdf::lobe_form_of(records, utf8(mesh.label()));
   return fits;
 }
 
 // Fits of a saved result PLY, which must be this mesh (same vertices in the same order).
-std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays) {
+std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays, vbrdf::LobeForm &lobe) {
   const vbrdf::ResultPly result = vbrdf::read_result_ply(path);
   const std::vector<float> &p = arrays.data.positions, &q = result.mesh.positions;
   const float tolerance = 1e-4f * std::max(1e-12f, vbrdf::compute_bounds(arrays.data.view()).diagonal());
@@ -109,7 +110,7 @@ std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const Mesh
     throw vbrdf::InputError("The fit result '" + path + "' has " + std::to_string(q.size() / 3) +
                             " vertices that do not match the current mesh (" + std::to_string(p.size() / 3) +
                             " vertices): choose the PLY the fit wrote for this mesh, or clear 'fitResultPly'.");
-  return vbrdf::fits_from_result(result, path);
+  return vbrdf::fits_from_result(result, path, &lobe);
 }
 
 struct RasterSet {
@@ -269,8 +270,8 @@ void RelightFilter::apply(FilterRun &run) const {
   const MeshArrays arrays = mesh_arrays(*mesh);
   const std::string project = project_path(run.document, *mesh);
   const std::vector<vbrdf::VertexFit> fits =
-      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays)
-                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays);
+      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays, s.render.lobe)
+                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays, s.render.lobe);
   const RasterSet set = rasters_to_render(run.document, *mesh, s);
   s.output_folder =
       s.output_folder.empty() ? default_output_folder(set.project) : resolve_path(s.output_folder, project);

@@ -92,6 +92,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("fitReflectance", BoolValue(false));
   p.setValue("fitBackend", EnumValue(1));
   p.setValue("initialShininess", FloatValue(20.0f));
+  p.setValue("specularLobe", EnumValue(0));
   p.setValue("maxIterations", IntValue(7));
   p.setValue("minSpecularSamples", IntValue(3));
   p.setValue("fillUnseenRings", IntValue(4));
@@ -108,6 +109,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, 0.3f);
   EXPECT_EQ(s.gather.encoding, vbrdf::PhotoEncoding::Linear);
   EXPECT_FLOAT_EQ(s.gather.saturation_level, 0.95f);
+  EXPECT_EQ(s.phong.lobe, vbrdf::LobeForm::PhongRE);
   EXPECT_EQ(s.gather.photo_cache_bytes, size_t(100) << 20);
   EXPECT_EQ(s.visibility_choice, vbrdf::VisibilityChoice::CPU);
   EXPECT_FLOAT_EQ(s.visibility.depth_tolerance, 0.01f);
@@ -139,6 +141,7 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
   rejects("memoryBudgetMB", IntValue(8));
   rejects("initialShininess", FloatValue(0.5f));
   rejects("maxIterations", IntValue(-1));
+  rejects("specularLobe", EnumValue(2));
   rejects("domeRadius", FloatValue(-1.0f));
   rejects("lightUnitScale", FloatValue(std::nanf("")));
   rejects("minSpecularSamples", IntValue(0));

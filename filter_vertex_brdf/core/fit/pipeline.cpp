@@ -130,6 +130,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   validate_input(input);
   FitSettings settings = settings_in;
   settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
+  settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
   if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
   const MeshView &mesh = input.mesh;
   FitResult result;

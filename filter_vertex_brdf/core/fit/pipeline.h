@@ -33,8 +33,16 @@ enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
 // and little more below. Coverage keeps 0.5: it asks the photographer for well-lit samples.
 constexpr float kFitDiffuseThreshold = 0.2f;
 
+// The product's lobe form (the filter's and vbrdf_fit's default; README "The lobe's form and several
+// cameras" has the measurements that chose it). PhongFitOptions keeps the thesis's R.E as the
+// core contract's default; the pipeline copies phong.lobe into gather.lobe.
+constexpr LobeForm kFitLobe = LobeForm::BlinnNH;
+
 struct FitSettings {
-  FitSettings() { gather.diffuse_threshold = kFitDiffuseThreshold; }
+  FitSettings() {
+    gather.diffuse_threshold = kFitDiffuseThreshold;
+    phong.lobe = gather.lobe = kFitLobe;
+  }
   GatherSettings gather;
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;

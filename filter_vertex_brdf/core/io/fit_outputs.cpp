@@ -79,6 +79,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
       rec.fit = f;
+      rec.lobe_form = float(uint8_t(settings.phong.lobe));
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -131,6 +132,10 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   for (size_t i = 0; i < input.rasters.size(); ++i)
     if (g.raster_seen_vertices[i] == 0)
       rep << "skipped: raster '" << input.rasters[i].label << "' sees no vertex (check its registration); its photo was not read\n";
+  if (settings.fit_reflectance)
+    rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
+        << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
+        << "); samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off") << "\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
