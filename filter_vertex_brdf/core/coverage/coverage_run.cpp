@@ -207,14 +207,17 @@ void build_texts(const CoverageInput &input, const CoverageSettings &settings, C
       << settings.gather.diffuse_threshold << "; covered = at least " << settings.min_diffuse << " diffuse / "
       << settings.min_specular << " specular sample(s); lights at least " << settings.suggest.min_elevation_deg
       << " deg above the image plane\n"
+      << (r.vertices_considered < n ? "only on selection: " + std::to_string(r.vertices_considered) + " of " +
+                                          std::to_string(n) + " vertices considered (counts below are of these)\n"
+                                    : std::string())
       << "legend (vertex colours) and counts:\n";
   static const char *const keys[4] = {"unseen", "seen_not_diffuse", "diffuse_no_specular", "fully_covered"};
-  static const char *const colour_names[4] = {"purple", "red", "yellow", "green"};
+  static const char *const colour_names[4] = {"purple", "blue", "yellow", "green"};
   for (int c = 0; c < 4; ++c) {
     const auto col = coverage_class_color(CoverageClass(c));
     rep << "  " << colour_names[c] << " (" << int(col[0]) << "," << int(col[1]) << "," << int(col[2])
         << "): " << coverage_class_name(CoverageClass(c)) << ": " << r.class_counts[c] << " ("
-        << percent(r.class_counts[c], n) << ")\n";
+        << percent(r.class_counts[c], r.vertices_considered) << ")\n";
   }
   if (!input.dq.empty())
     rep << "fit quality (" << (input.quality_source.empty() ? "per-vertex dq/sq" : input.quality_source)
@@ -450,9 +453,12 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   t = Clock::now();
   r.classes.resize(n);
   r.colors_rgba.resize(4 * n);
+  const auto considered = [&input](size_t v) { return input.vertex_mask.empty() || input.vertex_mask[v] != 0; };
   for (size_t v = 0; v < n; ++v) {
     const CoverageClass c = classify_coverage(r.counts[v], settings.min_diffuse, settings.min_specular);
     r.classes[v] = c;
+    if (!considered(v)) continue;
+    ++r.vertices_considered;
     ++r.class_counts[c];
     const auto col = coverage_class_color(c);
     std::copy(col.begin(), col.end(), r.colors_rgba.begin() + std::ptrdiff_t(4 * v));
@@ -460,10 +466,17 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   const Viewpoint &vp = r.viewpoints[r.viewpoint];
   std::vector<uint16_t> fail_d, fail_s;
   prediction_failures(mesh, r.classes, vp, sources, settings.suggest, fail_d, fail_s);
+  for (size_t v = 0; v < n; ++v)
+    if (!considered(v)) fail_d[v] = fail_s[v] = 0;
   for (size_t v = 0; v < n; ++v) r.failed_diffuse += fail_d[v] > 0, r.failed_specular += fail_s[v] > 0;
-  const CoverageNeeds needs = coverage_needs(r.counts, input.dq.empty() ? nullptr : input.dq.data(),
+  CoverageNeeds needs = coverage_needs(r.counts, input.dq.empty() ? nullptr : input.dq.data(),
                                              input.sq.empty() ? nullptr : input.sq.data(), settings, fail_d.data(),
                                              fail_s.data());
+  for (size_t v = 0; v < n; ++v)
+    if (!considered(v)) {
+      if (v < needs.diffuse.size()) needs.diffuse[v] = 0;
+      if (v < needs.specular.size()) needs.specular[v] = 0;
+    }
   r.poor_diffuse = needs.poor_diffuse, r.poor_specular = needs.poor_specular;
   std::vector<std::vector<uint8_t>> visible;
   for (const Viewpoint &viewpoint : r.viewpoints) visible.push_back(viewpoint_visible(masks, viewpoint));
@@ -485,7 +498,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   if (d_ok || s_ok) r.recommended = !s_ok || (d_ok && r.diffuse.covered_weight >= r.specular.covered_weight) ? 0 : 1;
   const std::vector<uint8_t> reasons = new_view_reasons(mesh, r.classes, visible, r.viewpoints, settings.suggest);
   for (size_t v = 0; v < n; ++v) {
-    if (!reasons[v]) continue;
+    if (!reasons[v] || !considered(v)) continue;
     r.new_view_vertices.push_back(uint32_t(v)), r.new_view_reasons.push_back(reasons[v]);
     bool clean = reasons[v] == kNewViewUnseen;
     for (size_t i = 0; i < visible.size() && !clean; ++i) clean = visible[i][v] != 0;

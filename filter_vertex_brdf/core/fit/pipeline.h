@@ -72,9 +72,18 @@ struct FitInput {
   std::vector<uint8_t> mesh_colors;    // RGBA8 per vertex (current colours, kept where unseen)
   std::vector<Raster> rasters;
   std::string project_path;            // the .mlp, used for default paths (may be empty)
+  // "Only on selection": per vertex, 0 = leave out (no sample is taken: it reads as seen by no
+  // photo, keeps its input colour, fit_status 0 unless fillUnseenRings reaches it). Empty: all.
+  std::vector<uint8_t> vertex_mask;
 };
 
 
+
+// Vertex quality of vertices without a model (fit_status 0) and of non-finite entries: the median
+// of the modelled vertices' quality (0 when none), so that in MeshLab's "Colorize by vertex
+// Quality" and its histogram they neither read as the worst (DQ/SQ 0) nor as the best (RMSE 0)
+// nor stretch the range. fit_status tells them apart.
+void neutral_quality_for_unmodelled(const std::vector<VertexFit> &fits, std::vector<float> &quality);
 
 // Checks everything that can be checked before any work: non-empty mesh with normals, at least
 // one raster, every raster with a valid shot and an existing photo of the shot's size.
