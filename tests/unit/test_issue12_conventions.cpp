@@ -11,6 +11,7 @@
 #include "coverage/coverage_run.h"
 #include "fit/pipeline.h"
 #include "inputs/project.h"
+#include "io/fit_outputs.h"
 #include "io/result_attach.h"
 #include "samples/samples.h"
 #include "test_paths.h"
