@@ -45,6 +45,20 @@ def errors(lp, photos, reference):
     return errs, len(got)
 
 
+def check_run(a, what, options, photos, reference, max_median, failures):
+    """Runs the tool with `options`; every photo must get a light within max_median / 3 deg."""
+    lp = os.path.join(a.workdir, what.replace(" ", "_") + ".lp")
+    rc, _ = run([a.tool, "--out", lp] + options + photos)
+    if rc != 0 or not os.path.isfile(lp):
+        failures.append(f"{what}: exit status {rc}, no .lp")
+        return
+    errs, count = errors(lp, photos, reference)
+    med, worst = errs[len(errs) // 2], errs[-1]
+    print(f"{what}: {count}/{len(photos)} lights, median {med:.2f} deg, max {worst:.2f} deg")
+    if count != len(photos) or med >= max_median or worst >= 3.0:
+        failures.append(f"{what}: {count} lights, median {med:.2f}, max {worst:.2f} (want all, < {max_median}, < 3)")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--tool", required=True)
@@ -62,16 +76,7 @@ def main():
         cx, cy, r = (f.read().split()[:3])
     failures = []
 
-    lp = os.path.join(a.workdir, "given.lp")
-    rc, _ = run([a.tool, "--out", lp, "--circle", cx, cy, r, "--origin", "bottom-left"] + photos)
-    if rc != 0 or not os.path.isfile(lp):
-        failures.append(f"given circle, bottom-left: exit status {rc}, no .lp")
-    else:
-        errs, count = errors(lp, photos, reference)
-        med, worst = errs[len(errs) // 2], errs[-1]
-        print(f"given circle: {count}/{len(photos)} lights, median {med:.2f} deg, max {worst:.2f} deg")
-        if count != len(photos) or med >= 1.0 or worst >= 3.0:
-            failures.append(f"given circle: {count} lights, median {med:.2f}, max {worst:.2f} (want all, < 1, < 3)")
+    check_run(a, "given circle", ["--circle", cx, cy, r, "--origin", "bottom-left"], photos, reference, 1.0, failures)
 
     wrong = os.path.join(a.workdir, "wrong.lp")
     rc, out = run([a.tool, "--out", wrong, "--circle", cx, cy, r, "--origin", "top-left"] + photos)
@@ -82,16 +87,7 @@ def main():
     if rc != 2 or os.path.exists(wrong):
         failures.append(f"--circle without --origin: exit status {rc}, want 2")
 
-    auto = os.path.join(a.workdir, "auto.lp")
-    rc, _ = run([a.tool, "--out", auto] + photos)
-    if rc != 0 or not os.path.isfile(auto):
-        failures.append(f"automatic: exit status {rc}, no .lp")
-    else:
-        errs, count = errors(auto, photos, reference)
-        med, worst = errs[len(errs) // 2], errs[-1]
-        print(f"automatic: {count}/{len(photos)} lights, median {med:.2f} deg, max {worst:.2f} deg")
-        if count != len(photos) or med >= 2.0 or worst >= 3.0:
-            failures.append(f"automatic: {count} lights, median {med:.2f}, max {worst:.2f} (want all, < 2, < 3)")
+    check_run(a, "automatic", [], photos, reference, 2.0, failures)
     if failures:
         print("FAILED:\n  " + "\n  ".join(failures))
         return 1
