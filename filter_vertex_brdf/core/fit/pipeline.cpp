@@ -25,6 +25,9 @@ std::string default_output_path(const std::string &project_path) {
 
 void validate_input(const FitInput &input) {
   validate_mesh(input.mesh, input.mesh_name);
+  if (!input.vertex_mask.empty() && input.vertex_mask.size() != input.mesh.vertex_count)
+    throw InputError("internal: the vertex selection has " + std::to_string(input.vertex_mask.size()) +
+                     " entries for " + std::to_string(input.mesh.vertex_count) + " vertices");
   if (input.rasters.empty())
     throw InputError("The project has no rasters: load the registered photos (File > Import Raster) or open the .mlp.");
   for (size_t r = 0; r < input.rasters.size(); ++r) {
@@ -174,7 +177,8 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
 
   auto t = Clock::now();
   const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
-  const VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
+  VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
+  restrict_to_vertices(masks, input.vertex_mask);
   result.seconds_visibility = seconds_since(t);
   prefetch->finish();
 

@@ -77,6 +77,9 @@ struct FitInput {
   std::vector<uint8_t> mesh_colors;    // RGBA8 per vertex (current colours, kept where unseen)
   std::vector<Raster> rasters;
   std::string project_path;            // the .mlp, used for default paths (may be empty)
+  // "Only on selection": per vertex, 0 = leave out (no sample is taken: it reads as seen by no
+  // photo, keeps its input colour, fit_status 0 unless fillUnseenRings reaches it). Empty: all.
+  std::vector<uint8_t> vertex_mask;
 };
 
 

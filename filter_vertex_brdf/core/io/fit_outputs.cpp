@@ -58,6 +58,32 @@ bool displayed_reflectance(const FitResult &r, size_t v, float rho[3]) {
 
 std::string report_path_for(const std::string &ply) { return strip_extension(ply) + "_report.txt"; }
 
+void neutral_quality_for_unmodelled(const std::vector<VertexFit> &fits, std::vector<float> &quality) {
+  std::vector<float> modelled;
+  for (size_t v = 0; v < fits.size() && v < quality.size(); ++v)
+    if (fits[v].status != kFitNone && std::isfinite(quality[v])) modelled.push_back(quality[v]);
+  float neutral = 0.0f;
+  if (!modelled.empty()) {
+    std::nth_element(modelled.begin(), modelled.begin() + std::ptrdiff_t(modelled.size() / 2), modelled.end());
+    neutral = modelled[modelled.size() / 2];
+  }
+  for (size_t v = 0; v < fits.size() && v < quality.size(); ++v)
+    if (fits[v].status == kFitNone || !std::isfinite(quality[v])) quality[v] = neutral;
+}
+
+namespace {
+
+// The report's line for "only on selection" ("" when every vertex took part).
+std::string only_on_selection(const FitInput &input) {
+  if (input.vertex_mask.empty()) return "";
+  const size_t kept =
+      size_t(std::count_if(input.vertex_mask.begin(), input.vertex_mask.end(), [](uint8_t m) { return m != 0; }));
+  return "only on selection: " + std::to_string(kept) + " of " + std::to_string(input.vertex_mask.size()) +
+         " vertices fitted (the others are left out, as if no photo saw them)\n";
+}
+
+} // namespace
+
 void build_outputs(const FitInput &input, const FitSettings &settings, FitResult &r) {
   const size_t n = input.mesh.vertex_count;
   r.colors_rgba.assign(4 * n, 0);
@@ -97,6 +123,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       if (e.n_seen == 0) ++r.vertices_unseen; else ++r.vertices_no_diffuse;
     }
   }
+  if (!r.fits.empty()) neutral_quality_for_unmodelled(r.fits, r.quality);
   r.attributes = result_attributes(records, !r.fits.empty());  // by name, in the schema's file order
 }
 
@@ -107,6 +134,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   std::ostringstream rep;
   rep << "filter_vertex_brdf report\n"
       << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
+      << only_on_selection(input)
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
       << "lights against the photos (predicted irradiance vs brightness): "
       << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"

@@ -132,6 +132,26 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
   return masks;
 }
 
+void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &vertex_mask) {
+  if (vertex_mask.empty()) return;
+  if (vertex_mask.size() != masks.vertex_count)
+    throw InputError("internal: vertex mask of " + std::to_string(vertex_mask.size()) + " entries for " +
+                     std::to_string(masks.vertex_count) + " vertices");
+  const size_t words = masks.words();
+  std::vector<uint64_t> keep(words, 0);
+  for (size_t v = 0; v < vertex_mask.size(); ++v)
+    if (vertex_mask[v]) keep[v / 64] |= uint64_t(1) << (v % 64);
+  for (size_t r = 0; r < masks.raster_count; ++r) {
+    uint32_t seen = 0;
+    for (size_t w = 0; w < words; ++w) {
+      for (std::vector<uint64_t> *bits : {&masks.seen, &masks.lit, &masks.mixed})
+        if (bits->size() == masks.raster_count * words) (*bits)[r * words + w] &= keep[w];
+      seen += uint32_t(__builtin_popcountll(masks.seen[r * words + w]));
+    }
+    if (r < masks.seen_count.size()) masks.seen_count[r] = seen;
+  }
+}
+
 uint16_t make_sample(const float position[3], const float normal_in[3], const Raster &raster, uint16_t raster_index,
                      const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
                      const GatherSettings &settings, Sample &out, uint8_t own_texels) {

@@ -127,6 +127,11 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
                                    const std::vector<LightSource> &lights,
                                    VisibilityBackend &backend, const ProgressFn &progress = {});
 
+// "Only on selection": clears the seen, lit and mixed bits of every vertex with vertex_mask[v] == 0,
+// so that no stage samples it (it reads as seen by no photo), and recounts seen_count. An empty
+// mask keeps every vertex. Throws InputError when the mask's size is not the vertex count.
+void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &vertex_mask);
+
 // Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`,
 // lit by `light` (its direction at the vertex: light_direction_at). The colour is the photo's,
 // NOT divided by the light's fall-off (apply_light_falloff does that, after colour correction).
