@@ -34,6 +34,7 @@
 #include <QDir>
 #include <opencv2/imgcodecs.hpp>
 
+#include "tool_errors.h"
 #include "bench_mesh.h"
 #include "bench_plot.h"
 #include "base/color_difference.h"
@@ -456,13 +457,7 @@ int main(int argc, char **argv) {
       {"fit", cmd_fit}, {"decimate", cmd_decimate}, {"srgb8", cmd_srgb8}, {"plot", cmd_plot}};
   const auto it = commands.find(cmd);
   if (it == commands.end()) return usage();
-  try {
+  return test::run_tool([&]() -> int {
     return it->second(parse(argc, argv, 2));
-  } catch (const InputError &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 3;
-  }
+  });
 }

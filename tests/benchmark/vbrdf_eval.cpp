@@ -40,6 +40,7 @@
 #include <memory>
 #include <string>
 
+#include "tool_errors.h"
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "inputs/light_file.h"
@@ -163,7 +164,7 @@ int main(int argc, char **argv) {
                  "                  [--below-baselines (needs --training)]\n";
     return 2;
   }
-  try {
+  return test::run_tool([&]() -> int {
     const ResultPly result = read_result_ply(result_path);
     LobeForm lobe = LobeForm::PhongRE;
     const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe);
@@ -260,11 +261,5 @@ int main(int argc, char **argv) {
       }
     }
     return ok ? 0 : 1;
-  } catch (const InputError &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 3;
-  }
+  });
 }

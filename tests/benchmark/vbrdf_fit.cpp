@@ -14,6 +14,7 @@
 #include <memory>
 #include <string>
 
+#include "tool_errors.h"
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "tools/mesh_io.h"
@@ -89,7 +90,7 @@ int main(int argc, char **argv) {
     else mlp = a;
   }
   const LogFn log = [](const std::string &line) { std::cout << line << "\n"; };
-  try {
+  return test::run_tool([&]() -> int {
     const Project project = read_project(mlp);
     const MeshData mesh = load_mesh_ply(project.mesh_path);
     FitInput input;
@@ -119,11 +120,5 @@ int main(int argc, char **argv) {
       fitter = make_phong_fitter(settings.fit_backend, get_proc, log);
     run_fit(input, settings, *visibility, fitter.get(), {}, log);
     return 0;
-  } catch (const InputError &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 3;
-  }
+  });
 }

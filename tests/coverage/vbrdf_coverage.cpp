@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "tool_errors.h"
 #include "coverage/coverage_run.h"
 #include "base/errors.h"
 #include "tools/mesh_io.h"
@@ -87,7 +88,7 @@ int main(int argc, char **argv) {
   }
   if (mlp.empty()) return usage();
   const LogFn log = [](const std::string &line) { std::cout << line << "\n"; };
-  try {
+  return test::run_tool([&]() -> int {
     const Project project = read_project(mlp);
     const MeshData mesh = load_mesh_ply(project.mesh_path);
     CoverageInput input;
@@ -111,11 +112,5 @@ int main(int argc, char **argv) {
     const CoverageResult r = run_coverage(input, settings, *visibility, {}, log);
     if (!classes_path.empty()) write_classes(classes_path, input.mesh, r);
     return 0;
-  } catch (const InputError &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 3;
-  }
+  });
 }

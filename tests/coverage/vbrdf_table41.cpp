@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "tool_errors.h"
 #include "tools/acquisition_sim.h"
 #include "coverage/coverage_run.h"
 #include "base/errors.h"
@@ -146,7 +147,7 @@ int main(int argc, char **argv) {
   }
   if (o.name.empty()) o.name = o.projects.front();
   const LogFn log = [](const std::string &line) { std::cout << line << "\n"; };
-  try {
+  return test::run_tool([&]() -> int {
     MeshData mesh;
     std::vector<Raster> rasters;
     std::vector<std::array<float, 3>> lights;
@@ -248,11 +249,5 @@ int main(int argc, char **argv) {
       if (!(b < r)) status = 1;
     }
     return status;
-  } catch (const InputError &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception &e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 3;
-  }
+  });
 }

@@ -8,6 +8,7 @@
 #include <random>
 #include <unistd.h>
 
+#include "tool_errors.h"
 #include "coverage/coverage_run.h"
 #include "io/coverage_outputs.h"
 #include "base/errors.h"
@@ -35,14 +36,7 @@ std::string read_text(const std::string &path) {
 
 void write_text(const std::string &path, const std::string &text) { std::ofstream(path) << text; }
 
-template <class F> std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError &e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 Raster raster_at(const std::string &label, const std::string &image, const Shot &shot) {
   Raster r;

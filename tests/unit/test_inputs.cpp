@@ -2,6 +2,7 @@
 #include <fstream>
 #include <gtest/gtest.h>
 
+#include "tool_errors.h"
 #include "inputs/camera.h"
 #include "base/errors.h"
 #include "base/file_util.h"
@@ -20,14 +21,7 @@ std::string write_file(const std::string &dir, const std::string &name, const st
   return path;
 }
 
-std::string error_of(const std::function<void()> &f) {
-  try {
-    f();
-  } catch (const InputError &e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 } // namespace
 
 TEST(LightFile, ParsesNamesWithSpacesAndNormalises) {

@@ -1,4 +1,4 @@
-// MeshLab's conventions in the core (issue 12): only on selection (fit's visibility masks, the
+// MeshLab's conventions in the core: only on selection (fit's visibility masks, the
 // coverage's vertex mask), vertex quality of unmodelled vertices, attaching a saved result to its
 // mesh, and the sphere checks behind vbrdf-lights (a given circle, several highlights).
 #include <cmath>
@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "tool_errors.h"
 #include "base/errors.h"
 #include "calibration/sphere_lights.h"
 #include "coverage/coverage_run.h"
@@ -21,14 +22,7 @@ using namespace vbrdf;
 
 namespace {
 
-template <class F> std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError &e) {
-    return e.what();
-  }
-  return "";
-}
+using test::error_of;
 
 // --- Only on selection ---------------------------------------------------------------------------
 
