@@ -288,6 +288,8 @@ void write_files(const CoverageSettings &settings, const CoverageInput &input, C
   if (r.suggestion_file == input.project_path || r.suggestion_file == r.light_file)
     throw InputError("The suggestion file '" + r.suggestion_file + "' would overwrite an input file: choose another.");
   r.vertex_list_file = strip_extension(r.suggestion_file) + "_new_view_vertices.txt";
+  check_output_path(r.vertex_list_file, settings.overwrite, "Suggestion file");
+  r.suggestion_note = check_output_path(r.suggestion_file, settings.overwrite, "Suggestion file");
   std::ostringstream list;
   list << "# Vertices (0-based, mesh order) only a new viewpoint can cover: index reason\n"
        << "# reason: unseen = no photo sees it; diffuse / specular = no placeable light of a registered "
@@ -389,6 +391,10 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   check.mesh_name = input.mesh_name;
   check.rasters = input.rasters;
   validate_input(check);
+  if (settings_in.write_files && settings_in.overwrite == OverwritePolicy::Refuse)  // before any work
+    check_output_path(settings_in.suggestion_file.empty() ? default_suggestion_path(input.project_path)
+                                                          : settings_in.suggestion_file,
+                      settings_in.overwrite, "Suggestion file");
   const MeshView &mesh = input.mesh;
   const size_t n = mesh.vertex_count;
   if ((!input.dq.empty() && input.dq.size() != n) || (!input.sq.empty() && input.sq.size() != n) ||
@@ -499,7 +505,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   if (settings.write_files) write_files(settings, input, r, kv_text);
   std::istringstream lines(r.report);
   for (std::string line; std::getline(lines, line);) log(line);
-  if (!r.suggestion_file.empty()) log("suggestions written to " + r.suggestion_file);
+  if (!r.suggestion_file.empty()) log("suggestions written to " + r.suggestion_file + " (" + r.suggestion_note + ")");
   report_progress(progress, 1.0f, "done");
   return r;
 }

@@ -11,6 +11,8 @@
 #include "inputs/light_file.h"
 #include "calibration/color_plan.h"
 #include "inputs/light_source.h"
+#include "inputs/mesh_file.h"
+#include "inputs/photo_content.h"
 #include "samples/light_check.h"
 #include "io/output_ply.h"
 #include "fit/phong_fit_gpu.h"
@@ -50,6 +52,10 @@ void validate_input(const FitInput &input) {
     if (!shot_is_valid(raster.shot))
       throw InputError("Raster " + std::to_string(r) + " ('" + raster.label +
                        "') has no valid camera: register it to the mesh first.");
+    if (shot_is_identity(raster.shot))
+      throw InputError("Raster " + std::to_string(r) + " ('" + raster.label +
+                       "') has an identity camera (at the world origin, looking along -z): it was not registered. "
+                       "Register it to the mesh first, or remove the raster.");
     if (!file_exists(raster.image_path))
       throw InputError("Raster " + std::to_string(r) + " ('" + raster.label + "'): photo '" + raster.image_path +
                        "' is missing. Restore the file or fix the path in the project.");
@@ -62,7 +68,8 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
   if (settings.visibility_choice != VisibilityChoice::CPU) {
     if (!get_proc) {
       if (settings.visibility_choice == VisibilityChoice::GL)
-        throw ProcessingError("The OpenGL visibility back end was requested but no GL context is available.");
+        throw ProcessingError("'Visibility' is set to GPU (OpenGL), but no GL context is available: set 'Visibility' "
+                            "to Auto or CPU (ray cast).");
       log("Visibility: no GL context, using the CPU ray caster.");
     } else {
       try {
@@ -70,7 +77,9 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
         log(std::string("Visibility: ") + gl->name() + ".");
         return gl;
       } catch (const ProcessingError &e) {
-        if (settings.visibility_choice == VisibilityChoice::GL) throw;
+        if (settings.visibility_choice == VisibilityChoice::GL)
+          throw ProcessingError(std::string("'Visibility' is set to GPU (OpenGL), but ") + e.what() +
+                                " Set 'Visibility' to Auto or CPU (ray cast).");
         log(std::string("Visibility: GL depth passes unavailable (") + e.what() + "); using the CPU ray caster.");
       }
     }
@@ -269,8 +278,11 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   const size_t n = mesh.vertex_count;
   const GatherStats &g = r.gather;
   std::ostringstream rep;
-  rep << "filter_vertex_brdf report\n"
-      << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
+  rep << "filter_vertex_brdf report\n";
+  for (const std::string &w : r.warnings) rep << w << "\n";
+  rep << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
+      << r.normals_source << "\n"
+      << (r.memory_note.empty() ? std::string() : r.memory_note + "\n")
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
       << "lights against the photos (predicted irradiance vs brightness): "
       << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
@@ -293,9 +305,6 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   for (const auto &f : flag_names)
     rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
   rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
-  for (size_t i = 0; i < input.rasters.size(); ++i)
-    if (g.raster_seen_vertices[i] == 0)
-      rep << "skipped: raster '" << input.rasters[i].label << "' sees no vertex (check its registration); its photo was not read\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
@@ -362,11 +371,14 @@ std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
         log(std::string("Phong fit: ") + gpu->name() + ".");
         return std::unique_ptr<PhongFitter>(gpu.release());
       } catch (const ProcessingError &e) {
-        if (settings.fit_backend == FitBackendChoice::GPU) throw;
+        if (settings.fit_backend == FitBackendChoice::GPU)
+          throw ProcessingError(std::string("'Fit back end' is set to GPU (compute shader), but ") + e.what() +
+                                " Set 'Fit back end' to Auto or CPU (reference).");
         log(std::string("Phong fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");
       }
     } else if (settings.fit_backend == FitBackendChoice::GPU) {
-      throw ProcessingError("The GPU fit back end was requested but no GL context is available.");
+      throw ProcessingError("'Fit back end' is set to GPU (compute shader), but no GL context is available: set "
+                            "'Fit back end' to Auto or CPU (reference).");
     }
   }
   std::unique_ptr<PhongFitter> cpu(new CpuFitter());
@@ -409,9 +421,29 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
     if (!protected_path.empty() && result.output_ply == protected_path)
       throw InputError("The output '" + result.output_ply + "' would overwrite an input file: choose another 'outputPly'.");
 
-  // Photos are validated (size, bit depth) before the long passes start.
+  check_output_path(report_path_for(result.output_ply), settings.overwrite, "Output PLY");
+  result.output_note = check_output_path(result.output_ply, settings.overwrite, "Output PLY");
+  result.normals_source = describe_normals_source(input.mesh_path);
+  log(result.normals_source + ".");
+
+  // Photos are validated (size, bit depth, content) before the long passes start.
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
-  for (const Raster &r : input.rasters) photos.get(r.image_path, r.width(), r.height());
+  std::vector<PhotoContent> contents;
+  size_t largest_photo = 0;
+  for (const Raster &r : input.rasters) {
+    const auto photo = photos.get(r.image_path, r.width(), r.height());
+    contents.push_back(analyse_photo(*photo));
+    largest_photo = std::max(largest_photo, photo->pixels.total() * photo->pixels.elemSize());
+  }
+  if (largest_photo > settings.gather.photo_cache_bytes) {
+    result.memory_note = "photo memory: a decoded photo needs " + std::to_string((largest_photo >> 20) + 1) +
+                         " MB, more than 'Photo memory (MB)' (" + std::to_string(settings.gather.photo_cache_bytes >> 20) +
+                         " MB): photos are kept one at a time and decoded again for each vertex chunk (slower); "
+                         "raise 'Photo memory (MB)' to keep them";
+    log("Vertex BRDF: " + result.memory_note + ".");
+  }
+  result.warnings = check_photo_contents(input.rasters, contents);
+  for (const std::string &w : result.warnings) log(w);
   // Before the long passes: a required chart that is missing fails early.
   if (progress) progress(0.0f, "colour calibration");
   ColorPlan colors = plan_colors(input, settings, light_directions(lights), photos, log);
@@ -423,6 +455,17 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
   const VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
   result.seconds_visibility = seconds_since(t);
+  if (std::all_of(masks.seen_count.begin(), masks.seen_count.end(), [](uint32_t c) { return c == 0; }))
+    throw InputError("No raster's camera sees the mesh (every vertex is outside every photo, behind its camera or "
+                     "back-facing): the registration does not match this mesh. Check that the project's rasters "
+                     "were registered to it. Nothing was written.");
+  for (size_t i = 0; i < input.rasters.size(); ++i)
+    if (masks.seen_count[i] == 0) {
+      result.warnings.push_back("WARNING: raster '" + input.rasters[i].label +
+                                "' sees no vertex of the mesh (its camera points elsewhere: check its registration); "
+                                "the other photos were used without it.");
+      log(result.warnings.back());
+    }
 
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
@@ -451,11 +494,26 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
 
   t = Clock::now();
   build_outputs(input, settings, result);
+  if (result.vertices_coloured == 0) {
+    result.warnings.push_back("WARNING: no vertex got a colour or a model: every sample was shadowed, saturated or "
+                              "unusable (see the counts below).");
+    log(result.warnings.back());
+  }
   result.report = build_report(input, settings, result);
-  write_result_ply(result.output_ply, mesh, result.colors_rgba, result.attributes);
-  result.seconds_output = seconds_since(t);
-  result.report += "output: " + result.output_ply + " (written in " + fixed(result.seconds_output) + " s)\n";
-  write_text_file_atomically(report_path_for(result.output_ply), result.report);
+  {
+    // PLY and report are committed together: a concurrent run writing the same files waits here.
+    OutputFolderLock lock(directory_of(result.output_ply));
+    if (settings.overwrite == OverwritePolicy::Refuse)  // again: another run may have written it meanwhile
+      check_output_path(result.output_ply, settings.overwrite, "Output PLY");
+    AtomicOutput ply(result.output_ply), report(report_path_for(result.output_ply));
+    stage_result_ply(ply, mesh, result.colors_rgba, result.attributes);
+    result.seconds_output = seconds_since(t);
+    result.report += "output: " + result.output_ply + " (" + result.output_note + "; written in " +
+                     fixed(result.seconds_output) + " s)\n";
+    stage_text_file(report, result.report);
+    ply.commit();
+    report.commit((long long)result.report.size());
+  }
 
   std::istringstream lines(result.report);
   for (std::string line; std::getline(lines, line);) log(line);
