@@ -178,7 +178,7 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
     // The GL back end needs the context current for its whole life: destroy it inside the scope.
     const bool needs_gl = settings.visibility_choice != vbrdf::VisibilityChoice::CPU;
     GlContextScope gl(needs_gl ? run.gl_context : nullptr, log);
-    auto visibility = vbrdf::make_coverage_visibility(input.mesh, settings, gl.get_proc(), log);
+    auto visibility = vbrdf::make_visibility_backend(input.mesh, settings.visibility_choice, settings.visibility, gl.get_proc(), log);
     result = vbrdf::run_coverage(input, settings, *visibility, progress_adapter(run.progress, "Vertex BRDF coverage: "),
                                  log);
   }

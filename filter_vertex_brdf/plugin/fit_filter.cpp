@@ -187,9 +187,9 @@ void FitFilter::apply(FilterRun &run) const {
     const bool needs_gl = settings.visibility_choice != vbrdf::VisibilityChoice::CPU || gpu_fit;
     GlContextScope gl(needs_gl ? run.gl_context : nullptr, log);
     std::unique_ptr<vbrdf::VisibilityBackend> visibility = vbrdf::make_visibility_backend(
-        input.mesh, settings, settings.visibility_choice == vbrdf::VisibilityChoice::CPU ? nullptr : gl.get_proc(), log);
+        input.mesh, settings.visibility_choice, settings.visibility, gl.get_proc(), log);
     std::unique_ptr<vbrdf::PhongFitter> fitter;
-    if (settings.fit_reflectance) fitter = vbrdf::make_phong_fitter(settings, gl.get_proc(), log);
+    if (settings.fit_reflectance) fitter = vbrdf::make_phong_fitter(settings.fit_backend, gl.get_proc(), log);
     result = vbrdf::run_fit(input, settings, *visibility, fitter.get(), progress_adapter(run.progress, "Vertex BRDF: "),
                             log);
   }

@@ -17,8 +17,8 @@ work=${2:-$build/cross_camera_eval}
 [ $# -ge 2 ] && shift 2 || shift $#
 shared=${VBRDF_SHARED_DIR:-$repo/../shared}
 cameras=${CAMERAS:-"spot_dir24 spot_dir24_view2"}
-fit=$build/tests/bench/vbrdf_fit
-eval_tool=$build/tests/bench/vbrdf_eval
+fit=$build/tests/benchmark/vbrdf_fit
+eval_tool=$build/tests/benchmark/vbrdf_eval
 for c in $cameras; do
   [ -f "$shared/scenes/$c/project.mlp" ] || { echo "SKIP: $shared/scenes/$c not found"; exit 0; }
 done

@@ -357,8 +357,8 @@ int cmd_fit(const Args &a) {
   const GetProcAddressFn get_proc = gl.get_proc_address();
   const LogFn quiet = [](const std::string &) {};
   auto t = Clock::now();
-  auto visibility = make_visibility_backend(input.mesh, settings, get_proc, quiet);
-  auto fitter = make_phong_fitter(settings, settings.fit_backend == FitBackendChoice::CPU ? nullptr : get_proc, quiet);
+  auto visibility = make_visibility_backend(input.mesh, settings.visibility_choice, settings.visibility, get_proc, quiet);
+  auto fitter = make_phong_fitter(settings.fit_backend, get_proc, quiet);
   const double t_init = since(t);
   t = Clock::now();
   const FitResult r = run_fit(input, settings, *visibility, fitter.get(), {}, quiet);

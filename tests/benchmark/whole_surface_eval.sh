@@ -5,7 +5,7 @@
 # over the ground-truth-visible vertices, beside PTM and Relight-style RBF fitted per pixel on the
 # same training photos and scored on the same samples.
 #   tests/benchmark/whole_surface_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_eval OPTIONS...]
-#     BUILD_DIR  default build/release (holding tests/bench/vbrdf_fit and vbrdf_eval)
+#     BUILD_DIR  default build/release (holding tests/benchmark/vbrdf_fit and vbrdf_eval)
 #     WORK_DIR   default $BUILD_DIR/whole_surface_eval (fit results and logs)
 #   environment: VBRDF_SHARED_DIR (default <repo>/../shared; VBRDF_SHARED is still read), SCENES (default the three below),
 #                VBRDF_FIT_OPTIONS (extra vbrdf_fit options, e.g. "--visibility cpu"),
@@ -21,8 +21,8 @@ work=${2:-$build/whole_surface_eval}
 [ $# -ge 2 ] && shift 2 || shift $#
 shared=${VBRDF_SHARED_DIR:-${VBRDF_SHARED:-$repo/../shared}}
 scenes=${SCENES:-"spot_dir24 bunny_two_materials_dir32 teapot_dir16 teapot_point16"}
-fit=$build/tests/bench/vbrdf_fit
-eval_tool=$build/tests/bench/vbrdf_eval
+fit=$build/tests/benchmark/vbrdf_fit
+eval_tool=$build/tests/benchmark/vbrdf_eval
 
 if [ ! -d "$shared/scenes" ]; then
   echo "SKIP: $shared/scenes not found (set VBRDF_SHARED_DIR to the folder holding scenes/)"

@@ -107,7 +107,7 @@ int main(int argc, char **argv) {
         log(std::string("OSMesa context unavailable: ") + e.what());
       }
     }
-    auto visibility = make_coverage_visibility(input.mesh, settings, get_proc, log);
+    auto visibility = make_visibility_backend(input.mesh, settings.visibility_choice, settings.visibility, get_proc, log);
     const CoverageResult r = run_coverage(input, settings, *visibility, {}, log);
     if (!classes_path.empty()) write_classes(classes_path, input.mesh, r);
     return 0;

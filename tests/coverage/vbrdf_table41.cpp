@@ -162,7 +162,7 @@ int main(int argc, char **argv) {
       }
     }
     const MeshView view = mesh.view();
-    auto visibility = make_coverage_visibility(view, o.coverage, get_proc, log);
+    auto visibility = make_visibility_backend(view, o.coverage.visibility_choice, o.coverage.visibility, get_proc, log);
     const auto t0 = std::chrono::steady_clock::now();
     const CandidateSet set = gather_candidates(view, rasters, lights, *visibility, o.coverage.gather);
     const double gather_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

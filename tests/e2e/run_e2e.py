@@ -215,9 +215,9 @@ def check_sane_output(out_ply, mesh, min_coloured):
     return failures
 
 
-def cmd_bad(a):
-    import bad_cases
-    case = bad_cases.BY_NAME[a.case]
+def project_copy(a):
+    """A fresh work folder with a copy of a.project's folder (without earlier results); returns
+    (work, source folder, its checksums, copy)."""
     work = fresh_dir(a.workdir)
     src_dir = os.path.dirname(os.path.abspath(a.project))
     src_before = lib.tree_checksums(src_dir)
@@ -225,6 +225,13 @@ def cmd_bad(a):
     shutil.copytree(src_dir, proj_dir)
     for stale in [f for f in os.listdir(proj_dir) if f.endswith("_brdf.ply") or f.endswith("_report.txt")]:
         os.remove(os.path.join(proj_dir, stale))
+    return work, src_dir, src_before, proj_dir
+
+
+def cmd_bad(a):
+    import bad_cases
+    case = bad_cases.BY_NAME[a.case]
+    work, src_dir, src_before, proj_dir = project_copy(a)
     mlp = os.path.join(proj_dir, os.path.basename(a.project))
     lps = sorted(f for f in os.listdir(proj_dir) if f.endswith(".lp"))
     out_dir = fresh_dir(os.path.join(work, "out"))
@@ -287,13 +294,7 @@ def cmd_fault(a):
     """A fault while writing (fault_cases.py) on an unbroken copy of the project."""
     import fault_cases
     fault = fault_cases.BY_NAME[a.case]
-    work = fresh_dir(a.workdir)
-    src_dir = os.path.dirname(os.path.abspath(a.project))
-    src_before = lib.tree_checksums(src_dir)
-    proj_dir = os.path.join(work, "project")
-    shutil.copytree(src_dir, proj_dir)
-    for stale in [f for f in os.listdir(proj_dir) if f.endswith("_brdf.ply") or f.endswith("_report.txt")]:
-        os.remove(os.path.join(proj_dir, stale))
+    work, src_dir, src_before, proj_dir = project_copy(a)
     out_dir = fresh_dir(os.path.join(work, "out"))
     for name, data in fault_cases.PREVIOUS.items():
         with open(os.path.join(out_dir, name), "wb") as f:

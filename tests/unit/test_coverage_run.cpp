@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "coverage/coverage_run.h"
+#include "io/coverage_outputs.h"
 #include "base/errors.h"
 #include "inputs/light_file.h"
 #include "tools/mesh_io.h"

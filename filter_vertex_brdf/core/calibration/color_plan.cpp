@@ -46,7 +46,7 @@ const ColorCalibration *ColorPlan::of_raster(size_t r) const {
 ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
                                 const std::vector<std::array<float, 3>> &lights_world,
                                 const ColorCorrectionSettings &settings, const std::function<cv::Mat(size_t)> &load,
-                                const std::function<void(const std::string &)> &log) {
+                                const LogFn &log) {
   ColorPlan plan;
   if (settings.choice == ColorCorrectionChoice::Off) return plan;
   const std::vector<std::vector<size_t>> groups = rasters_by_viewpoint(rasters);

@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "base/callbacks.h"
 #include "inputs/camera.h"
 #include "calibration/color_chart.h"
 #include "samples/samples.h"
@@ -44,7 +45,7 @@ struct ColorPlan {
 ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
                                 const std::vector<std::array<float, 3>> &lights_world,
                                 const ColorCorrectionSettings &settings, const std::function<cv::Mat(size_t)> &load,
-                                const std::function<void(const std::string &)> &log);
+                                const LogFn &log);
 
 // In place: corrected = M(rgb / exposure) for every sample of a corrected viewpoint. Negative
 // results (a matrix applied to noise in dark pixels) are no light, and NaN is none: both become 0.

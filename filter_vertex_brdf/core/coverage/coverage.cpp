@@ -14,37 +14,23 @@ namespace {
 constexpr float kPiF = float(kPi);  // float maths here
 constexpr float kDeg = kPiF / 180.0f;
 
-struct V3 {
-  float x, y, z;
-};
-inline V3 v3(const float *p) { return {p[0], p[1], p[2]}; }
-inline float dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 add(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 scale(V3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-inline V3 normalized(V3 a) {
-  const float l = std::sqrt(dot(a, a));
-  return l > 0 ? scale(a, 1 / l) : V3{0, 0, 0};
-}
-inline V3 reflect_about(V3 v, V3 n) { return add(scale(n, 2 * dot(n, v)), scale(v, -1)); }
-inline void store(V3 a, float *out) { out[0] = a.x, out[1] = a.y, out[2] = a.z; }
-
 // Camera axes in world coordinates (rows of the shot rotation).
-V3 camera_axis(const Shot &shot, int row) {
+Vec3 camera_axis(const Shot &shot, int row) {
   const vcg::Matrix44f r = shot.Extrinsics.Rot();
   return normalized({r[row][0], r[row][1], r[row][2]});
 }
 
-V3 eye_direction(const Shot &shot, const float *p) {
+Vec3 eye_direction(const Shot &shot, const float *p) {
   float c[3];
   camera_centre(shot, c);
   return normalized({c[0] - p[0], c[1] - p[1], c[2] - p[2]});
 }
 
-bool placeable(V3 light_dir, V3 cam_z, float min_elevation_deg) {
+bool placeable(Vec3 light_dir, Vec3 cam_z, float min_elevation_deg) {
   return dot(light_dir, cam_z) >= std::sin(min_elevation_deg * kDeg);
 }
 
-bool covers(CoverageKind kind, V3 n, V3 e, V3 l, const LightSuggestionSettings &s) {
+bool covers(CoverageKind kind, Vec3 n, Vec3 e, Vec3 l, const LightSuggestionSettings &s) {
   const float d = dot(n, l);
   if (d <= 0) return false;
   const float spec = dot(reflect_about(l, n), e);
@@ -54,10 +40,10 @@ bool covers(CoverageKind kind, V3 n, V3 e, V3 l, const LightSuggestionSettings &
 
 // Moves `l` towards the camera axis in 2-degree steps until it is placeable and still covers the
 // vertex; false when no such light exists on that arc.
-bool make_placeable(V3 &l, V3 n, V3 e, V3 cam_z, CoverageKind kind, const LightSuggestionSettings &s) {
-  const V3 start = l;
+bool make_placeable(Vec3 &l, Vec3 n, Vec3 e, Vec3 cam_z, CoverageKind kind, const LightSuggestionSettings &s) {
+  const Vec3 start = l;
   for (float t = 0; t <= 1.0001f; t += 1.0f / 45) {
-    const V3 cand = normalized(add(scale(start, 1 - t), scale(cam_z, t)));
+    const Vec3 cand = normalized(add(scale(start, 1 - t), scale(cam_z, t)));
     if (placeable(cand, cam_z, s.min_elevation_deg) && covers(kind, n, e, cand, s)) {
       l = cand;
       return true;
@@ -67,14 +53,14 @@ bool make_placeable(V3 &l, V3 n, V3 e, V3 cam_z, CoverageKind kind, const LightS
 }
 
 // Any unit vector perpendicular to n.
-V3 perpendicular(V3 n) {
-  const V3 a = std::fabs(n.x) < 0.9f ? V3{1, 0, 0} : V3{0, 1, 0};
+Vec3 perpendicular(Vec3 n) {
+  const Vec3 a = std::fabs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
   return normalized(add(a, scale(n, -dot(a, n))));
 }
 
-bool ideal_light(CoverageKind kind, V3 n, V3 e, const Shot &viewpoint, const LightSuggestionSettings &s, V3 &l) {
+bool ideal_light(CoverageKind kind, Vec3 n, Vec3 e, const Shot &viewpoint, const LightSuggestionSettings &s, Vec3 &l) {
   if (dot(n, e) <= 0) return false;  // back-facing: no light helps from this viewpoint
-  const V3 cam_z = camera_axis(viewpoint, 2);
+  const Vec3 cam_z = camera_axis(viewpoint, 2);
   if (kind == CoverageKind::Specular) {
     l = reflect_about(e, n);  // Algorithm 3: mirror direction, R = E, s = 1
   } else {
@@ -83,7 +69,7 @@ bool ideal_light(CoverageKind kind, V3 n, V3 e, const Shot &viewpoint, const Lig
     const float phi = std::acos(std::min(1.0f, dot(n, e)));
     const float limit = std::acos(std::min(1.0f, s.specular_threshold)) + s.margin_deg * kDeg;
     const float theta = std::max(0.0f, limit - phi);
-    V3 towards_e = add(e, scale(n, -dot(n, e)));
+    Vec3 towards_e = add(e, scale(n, -dot(n, e)));
     towards_e = dot(towards_e, towards_e) > 1e-12f ? normalized(towards_e) : perpendicular(n);
     l = normalized(add(scale(n, std::cos(theta)), scale(towards_e, std::sin(theta))));
   }
@@ -91,7 +77,7 @@ bool ideal_light(CoverageKind kind, V3 n, V3 e, const Shot &viewpoint, const Lig
 }
 
 // Octahedral index of a unit vector on a res x res grid.
-int octa_cell(V3 n, int res) {
+int octa_cell(Vec3 n, int res) {
   const float a = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
   float u = n.x / a, v = n.y / a;
   if (n.z < 0) {
@@ -133,8 +119,8 @@ std::vector<Group> group_vertices(const MeshView &mesh, const Shot &viewpoint, c
       const size_t v = size_t(vi);
       if (!visible[v] || !(needs[v] > 0)) continue;
       const float *p = mesh.positions + 3 * v;
-      const V3 n = normalized(v3(mesh.normals + 3 * v));
-      const V3 e = eye_direction(viewpoint, p);
+      const Vec3 n = normalized(vec3_of(mesh.normals + 3 * v));
+      const Vec3 e = eye_direction(viewpoint, p);
       const ImagePoint ip = project_to_image(viewpoint, p);
       const int tx = std::min(kTiles - 1, std::max(0, int(ip.x / w * kTiles)));
       const int ty = std::min(kTiles - 1, std::max(0, int(ip.y / h * kTiles)));
@@ -154,14 +140,14 @@ std::vector<Group> group_vertices(const MeshView &mesh, const Shot &viewpoint, c
       sum.weight += g.weight, sum.count += g.count;
     }
     if (sum.count == 0) continue;
-    store(normalized(v3(sum.n)), sum.n);
-    store(normalized(v3(sum.e)), sum.e);
+    store(normalized(vec3_of(sum.n)), sum.n);
+    store(normalized(vec3_of(sum.e)), sum.e);
     groups.push_back(sum);
   }
   return groups;
 }
 
-LightSuggestion describe(V3 l, const Shot &viewpoint) {
+LightSuggestion describe(Vec3 l, const Shot &viewpoint) {
   LightSuggestion out;
   out.valid = true;
   store(l, out.dir_world);
@@ -174,9 +160,9 @@ LightSuggestion describe(V3 l, const Shot &viewpoint) {
 // Latitude/longitude bins in the camera frame with running-average representatives (Alg. 2).
 class LightBins {
 public:
-  explicit LightBins(int parts) : parts_(parts), sum_(size_t(parts) * parts, V3{0, 0, 0}), weight_(sum_.size(), 0) {}
+  explicit LightBins(int parts) : parts_(parts), sum_(size_t(parts) * parts, Vec3{0, 0, 0}), weight_(sum_.size(), 0) {}
 
-  void insert(V3 l_cam, double w) {
+  void insert(Vec3 l_cam, double w) {
     const int lat = lat_index(l_cam), lon = lon_index(l_cam);
     int best = lat * parts_ + lon;
     float best_cos = -2;
@@ -192,38 +178,38 @@ public:
     weight_[size_t(best)] += w;
   }
 
-  std::vector<V3> representatives() const {
-    std::vector<V3> reps;
+  std::vector<Vec3> representatives() const {
+    std::vector<Vec3> reps;
     for (size_t i = 0; i < sum_.size(); ++i)
       if (weight_[i] > 0) reps.push_back(normalized(sum_[i]));
     return reps;
   }
 
 private:
-  int lat_index(V3 l) const {
+  int lat_index(Vec3 l) const {
     const float lat = std::asin(std::max(-1.0f, std::min(1.0f, l.z)));  // elevation
     return std::min(parts_ - 1, std::max(0, int((lat / kPiF + 0.5f) * parts_)));
   }
-  int lon_index(V3 l) const {
+  int lon_index(Vec3 l) const {
     const float lon = std::atan2(l.y, l.x);
     return std::min(parts_ - 1, std::max(0, int((lon / (2 * kPiF) + 0.5f) * parts_)));
   }
   int parts_;
-  std::vector<V3> sum_;
+  std::vector<Vec3> sum_;
   std::vector<double> weight_;
 };
 
-V3 to_camera(const Shot &shot, V3 w) {
+Vec3 to_camera(const Shot &shot, Vec3 w) {
   float in[3], out[3];
   store(w, in);
   world_to_camera_direction(shot, in, out);
-  return v3(out);
+  return vec3_of(out);
 }
-V3 to_world(const Shot &shot, V3 c) {
+Vec3 to_world(const Shot &shot, Vec3 c) {
   float in[3], out[3];
   store(c, in);
   camera_to_world_direction(shot, in, out);
-  return v3(out);
+  return vec3_of(out);
 }
 } // namespace
 
@@ -266,42 +252,42 @@ CoverageClass classify_coverage(const CoverageCounts &c, int min_diffuse, int mi
 }
 
 bool light_is_placeable(const Shot &viewpoint, const float dir_world[3], float min_elevation_deg) {
-  return placeable(normalized(v3(dir_world)), camera_axis(viewpoint, 2), min_elevation_deg);
+  return placeable(normalized(vec3_of(dir_world)), camera_axis(viewpoint, 2), min_elevation_deg);
 }
 
 bool ideal_diffuse_light(const float normal[3], const float eye[3], const Shot &viewpoint,
                          const LightSuggestionSettings &s, float out[3]) {
-  V3 l;
-  if (!ideal_light(CoverageKind::Diffuse, normalized(v3(normal)), normalized(v3(eye)), viewpoint, s, l)) return false;
+  Vec3 l;
+  if (!ideal_light(CoverageKind::Diffuse, normalized(vec3_of(normal)), normalized(vec3_of(eye)), viewpoint, s, l)) return false;
   store(l, out);
   return true;
 }
 
 bool ideal_specular_light(const float normal[3], const float eye[3], const Shot &viewpoint,
                           const LightSuggestionSettings &s, float out[3]) {
-  V3 l;
-  if (!ideal_light(CoverageKind::Specular, normalized(v3(normal)), normalized(v3(eye)), viewpoint, s, l)) return false;
+  Vec3 l;
+  if (!ideal_light(CoverageKind::Specular, normalized(vec3_of(normal)), normalized(vec3_of(eye)), viewpoint, s, l)) return false;
   store(l, out);
   return true;
 }
 
 bool light_covers_diffuse(const float n[3], const float e[3], const float l[3], const LightSuggestionSettings &s) {
-  return covers(CoverageKind::Diffuse, normalized(v3(n)), normalized(v3(e)), normalized(v3(l)), s);
+  return covers(CoverageKind::Diffuse, normalized(vec3_of(n)), normalized(vec3_of(e)), normalized(vec3_of(l)), s);
 }
 bool light_covers_specular(const float n[3], const float e[3], const float l[3], const LightSuggestionSettings &s) {
-  return covers(CoverageKind::Specular, normalized(v3(n)), normalized(v3(e)), normalized(v3(l)), s);
+  return covers(CoverageKind::Specular, normalized(vec3_of(n)), normalized(vec3_of(e)), normalized(vec3_of(l)), s);
 }
 
 size_t count_covered(const MeshView &mesh, const Shot &viewpoint, const uint8_t *visible, const float *needs,
                      CoverageKind kind, const float dir_world[3], const LightSuggestionSettings &s) {
-  const V3 l = normalized(v3(dir_world));
+  const Vec3 l = normalized(vec3_of(dir_world));
   size_t n = 0;
 #pragma omp parallel for reduction(+ : n) schedule(static)
   for (long long vi = 0; vi < (long long)mesh.vertex_count; ++vi) {
     const size_t v = size_t(vi);
     if (!visible[v] || !(needs[v] > 0)) continue;
-    const V3 e = eye_direction(viewpoint, mesh.positions + 3 * v);
-    if (covers(kind, normalized(v3(mesh.normals + 3 * v)), e, l, s)) ++n;
+    const Vec3 e = eye_direction(viewpoint, mesh.positions + 3 * v);
+    if (covers(kind, normalized(vec3_of(mesh.normals + 3 * v)), e, l, s)) ++n;
   }
   return n;
 }
@@ -313,19 +299,19 @@ LightSuggestion suggest_next_light(const MeshView &mesh, const Shot &viewpoint, 
   size_t needing = 0, uncoverable = 0;
   for (const Group &g : groups) {
     needing += g.count;
-    V3 l;
-    if (ideal_light(kind, v3(g.n), v3(g.e), viewpoint, s, l)) bins.insert(to_camera(viewpoint, l), g.weight);
+    Vec3 l;
+    if (ideal_light(kind, vec3_of(g.n), vec3_of(g.e), viewpoint, s, l)) bins.insert(to_camera(viewpoint, l), g.weight);
     else uncoverable += g.count;
   }
-  const std::vector<V3> reps = bins.representatives();
+  const std::vector<Vec3> reps = bins.representatives();
   double best_score = 0;
-  V3 best{0, 0, 0};
-  for (const V3 &rep_cam : reps) {
-    const V3 l = to_world(viewpoint, rep_cam);
+  Vec3 best{0, 0, 0};
+  for (const Vec3 &rep_cam : reps) {
+    const Vec3 l = to_world(viewpoint, rep_cam);
     if (!placeable(l, camera_axis(viewpoint, 2), s.min_elevation_deg)) continue;
     double score = 0;
     for (const Group &g : groups)
-      if (covers(kind, v3(g.n), v3(g.e), l, s)) score += g.weight;
+      if (covers(kind, vec3_of(g.n), vec3_of(g.e), l, s)) score += g.weight;
     if (score > best_score) best_score = score, best = l;
   }
   LightSuggestion out;
@@ -344,15 +330,15 @@ LightSuggestion suggest_next_light_brute_force(const MeshView &mesh, const Shot 
   std::vector<size_t> needing;
   for (size_t v = 0; v < mesh.vertex_count; ++v)
     if (visible[v] && needs[v] > 0) needing.push_back(v);
-  std::vector<V3> normals, eyes;
+  std::vector<Vec3> normals, eyes;
   for (size_t v : needing) {
-    normals.push_back(normalized(v3(mesh.normals + 3 * v)));
+    normals.push_back(normalized(vec3_of(mesh.normals + 3 * v)));
     eyes.push_back(eye_direction(viewpoint, mesh.positions + 3 * v));
   }
   LightSuggestion out;
   double best_score = 0;
   for (size_t i = 0; i < needing.size(); ++i) {
-    V3 l;
+    Vec3 l;
     if (!ideal_light(kind, normals[i], eyes[i], viewpoint, s, l)) {
       ++out.uncoverable_vertices;
       continue;

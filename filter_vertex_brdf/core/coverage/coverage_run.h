@@ -115,11 +115,6 @@ struct CoverageResult {
   double seconds_visibility = 0, seconds_gather = 0, seconds_suggest = 0;
 };
 
-// Visibility back end as make_visibility_backend does for the fit (GL when `get_proc` is given).
-std::unique_ptr<VisibilityBackend> make_coverage_visibility(const MeshView &mesh, const CoverageSettings &settings,
-                                                            const std::function<void *(const char *)> &get_proc,
-                                                            const LogFn &log);
-
 // Runs everything and, when settings.write_files, writes the suggestion file (key: value lines
 // plus the report) and beside it the list of vertices only a new viewpoint can cover
 // (<suggestion file stem>_new_view_vertices.txt), both atomically. Suggestions learn from the
@@ -131,13 +126,5 @@ std::unique_ptr<VisibilityBackend> make_coverage_visibility(const MeshView &mesh
 // entry for every raster.
 CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &settings, VisibilityBackend &visibility,
                             const ProgressFn &progress, const LogFn &log);
-
-// The default suggestion file: <project folder>/<project name>_next_light.txt
-// ("vertex_brdf_next_light.txt" when no project path is known).
-std::string default_suggestion_path(const std::string &project_path);
-
-// Keys of the suggestion file ("key: value" lines): read back by tests and scripts.
-// Returns the value of `key`, or "" when absent.
-std::string suggestion_value(const std::string &suggestion_text, const std::string &key);
 
 } // namespace vbrdf

@@ -56,7 +56,7 @@ std::vector<std::string> new_photos_in_folder(const std::string &folder, const s
 std::vector<LightEntry> sphere_light_entries(const std::vector<std::string> &photos, const std::vector<size_t> &wanted,
                                              const Shot &shot, const SphereCircle &manual,
                                              const std::string &lp_folder,
-                                             const std::function<void(const std::string &)> &log) {
+                                             const LogFn &log) {
   LightSettings settings;
   if (manual.r > 0) settings.manual_spheres.push_back(manual);
   std::vector<std::string> names;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "base/callbacks.h"
 #include "calibration/sphere_lights.h"
 #include "inputs/camera.h"
 #include "inputs/light_file.h"
@@ -25,7 +26,7 @@ std::vector<std::string> new_photos_in_folder(const std::string &folder, const s
 std::vector<LightEntry> sphere_light_entries(const std::vector<std::string> &photos, const std::vector<size_t> &wanted,
                                              const Shot &shot, const SphereCircle &manual,
                                              const std::string &lp_folder,
-                                             const std::function<void(const std::string &)> &log);
+                                             const LogFn &log);
 
 // Entries of `existing` (kept in order, except those naming the same image file as an entry of
 // `added`) followed by `added`.

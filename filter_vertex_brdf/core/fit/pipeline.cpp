@@ -1,42 +1,23 @@
 #include "fit/pipeline.h"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
 #include "base/errors.h"
 #include "base/file_util.h"
-#include "inputs/light_file.h"
-#include "calibration/color_plan.h"
-#include "inputs/light_source.h"
 #include "inputs/mesh_file.h"
 #include "inputs/photo_content.h"
-#include "samples/light_check.h"
-#include "io/output_ply.h"
-#include "fit/phong_fit_gpu.h"
-#include "io/result_schema.h"
-#include "visibility/visibility_gl.h"
 #include "base/vec3.h"
+#include "calibration/color_plan.h"
+#include "inputs/light_file.h"
+#include "inputs/light_source.h"
+#include "io/fit_outputs.h"
+#include "io/output_ply.h"
+#include "samples/light_check.h"
 
 namespace vbrdf {
-
-namespace {
-
-
-
-std::string report_path_for(const std::string &ply) { return strip_extension(ply) + "_report.txt"; }
-
-uint8_t srgb_byte(float linear) { return uint8_t(std::lround(255.0f * linear_to_srgb(linear))); }
-
-int bit(uint16_t flag) {
-  int i = 0;
-  while (flag > 1) flag >>= 1, ++i;
-  return i;
-}
-
-} // namespace
 
 std::string default_output_path(const std::string &project_path) {
   if (project_path.empty()) return "vertex_brdf.ply";
@@ -62,60 +43,7 @@ void validate_input(const FitInput &input) {
   }
 }
 
-std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh, const FitSettings &settings,
-                                                           const std::function<void *(const char *)> &get_proc,
-                                                           const LogFn &log) {
-  if (settings.visibility_choice != VisibilityChoice::CPU) {
-    if (!get_proc) {
-      if (settings.visibility_choice == VisibilityChoice::GL)
-        throw ProcessingError("'Visibility' is set to GPU (OpenGL), but no GL context is available: set 'Visibility' "
-                            "to Auto or CPU (ray cast).");
-      log("Visibility: no GL context, using the CPU ray caster.");
-    } else {
-      try {
-        auto gl = make_gl_visibility(mesh, get_proc, settings.visibility);
-        log(std::string("Visibility: ") + gl->name() + ".");
-        return gl;
-      } catch (const ProcessingError &e) {
-        if (settings.visibility_choice == VisibilityChoice::GL)
-          throw ProcessingError(std::string("'Visibility' is set to GPU (OpenGL), but ") + e.what() +
-                                " Set 'Visibility' to Auto or CPU (ray cast).");
-        log(std::string("Visibility: GL depth passes unavailable (") + e.what() + "); using the CPU ray caster.");
-      }
-    }
-  }
-  auto cpu = make_cpu_visibility(mesh, settings.visibility);
-  log(std::string("Visibility: ") + cpu->name() + ".");
-  return cpu;
-}
-
 namespace {
-class CpuFitter : public PhongFitter {
-public:
-  // `why`: how it came to be chosen, appended to the name (the report shows it).
-  explicit CpuFitter(const std::string &why = "") : name_("CPU (double, OpenMP)" + (why.empty() ? "" : "; " + why)) {}
-  const char *name() const override { return name_.c_str(); }
-  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
-    fit_chunk_cpu(chunk, o, out);
-  }
-
-private:
-  std::string name_;
-};
-
-class GpuFitter : public PhongFitter {
-public:
-  explicit GpuFitter(const GetProcAddressFn &get_proc) : gpu_(get_proc), name_("GPU compute shader, " + gpu_.device()) {}
-  const char *name() const override { return name_.c_str(); }
-  std::string device() const { return gpu_.device(); }
-  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
-    gpu_.fit_chunk(chunk, o, out);
-  }
-
-private:
-  PhongFitGpu gpu_;
-  std::string name_;
-};
 
 // ---- Colour correction (color_chart.h), per viewpoint ----
 
@@ -137,27 +65,6 @@ ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
   return plan_color_correction(input.rasters, lights_world, cs, load, log);
 }
 
-std::string color_report(const FitResult &r, const FitSettings &settings) {
-  if (settings.color_correction == ColorCorrectionChoice::Off) return "colour correction: off\n";
-  std::ostringstream rep;
-  for (size_t v = 0; v < r.colors.size(); ++v) {
-    const ColorCalibration &c = r.colors[v];
-    rep << "colour correction, viewpoint " << v + 1 << " (" << c.divisor.size() << " photos): ";
-    if (!c.corrected) {
-      rep << (c.patches.empty() ? "no chart found" : "chart not usable") << ": colours uncorrected\n";
-      continue;
-    }
-    const double heldout = std::min({c.fit.heldout_matrix, c.fit.heldout_curve_matrix, c.fit.heldout_polynomial});
-    const std::string exposure = c.exposure_normalised
-                                     ? "normalised per photo (light intensity varies)"
-                                     : "one for all photos (divisor " + fixed(c.divisor.at(0), 4) + ")";
-    rep << correction_model_name(c.correction.model) << " from " << (c.chart.detected ? "the detected" : "the given")
-        << " chart, " << c.fit.patches << " patches, CIEDE2000 " << fixed(c.fit.before) << " -> " << fixed(c.fit.after)
-        << " (held-out " << fixed(heldout) << "); exposure " << exposure
-        << "; samples corrected in linear space before the fit\n";
-  }
-  return rep.str();
-}
 
 // Everything the chunk consumer produces, per vertex.
 void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options, FitResult &r,
@@ -221,170 +128,7 @@ void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &
         " seen vertices have no usable sample and no vertex of the mesh has a model: left without a model.");
 }
 
-// Linear diffuse reflectance shown and written: the fitted k_d C where the Phong fit has samples,
-// else the basic estimate (mixed-pixel fallback included), else nothing.
-bool displayed_reflectance(const FitResult &r, size_t v, float rho[3]) {
-  if (!r.fits.empty() && r.fits[v].status != kFitNone) {
-    for (int c = 0; c < 3; ++c) rho[c] = r.fits[v].kd * r.fits[v].color[c];
-    return true;
-  }
-  for (int c = 0; c < 3; ++c) rho[c] = r.diffuse[v].valid ? r.diffuse[v].rgb[c] : 0.0f;
-  return r.diffuse[v].valid;
-}
-
-void build_outputs(const FitInput &input, const FitSettings &settings, FitResult &r) {
-  const size_t n = input.mesh.vertex_count;
-  r.colors_rgba.assign(4 * n, 0);
-  r.quality.assign(n, 0.0f);
-  std::vector<VertexRecord> records(n);
-  for (size_t v = 0; v < n; ++v) {
-    const DiffuseEstimate &e = r.diffuse[v];
-    VertexRecord &rec = records[v];
-    float rho[3];
-    const bool coloured = displayed_reflectance(r, v, rho);
-    for (int c = 0; c < 3; ++c) rec.diffuse[c] = rho[c];
-    rec.n_visible = e.n_seen, rec.n_diffuse = e.n_diffuse, rec.n_specular = e.n_specular;
-    // coloured = 2: the colour comes only from pixels at a silhouette or contact (own-surface texels
-    // of a straddling footprint, or mixed pixels): lower confidence than clean pixels.
-    const bool mixed = e.from_mixed_pixels || e.from_rim_pixels;
-    const bool from_neighbours = !r.fits.empty() && r.fits[v].status == kFitFromNeighbours;
-    rec.coloured = coloured ? (from_neighbours ? 3.0f : mixed ? 2.0f : 1.0f) : 0.0f;
-    if (v < r.materials.label.size()) rec.material = float(r.materials.label[v]);
-    if (!r.fits.empty()) {
-      const VertexFit &f = r.fits[v];
-      rec.fit = f;
-      r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
-      r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
-      r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
-      r.fit_converged += f.status == kFitFull && f.converged, r.fit_iterations += f.iterations;
-    }
-    if (coloured) {
-      for (int c = 0; c < 3; ++c) r.colors_rgba[4 * v + size_t(c)] = srgb_byte(rho[c]);
-      r.colors_rgba[4 * v + 3] = 255;
-      ++r.vertices_coloured;
-      r.vertices_from_mixed += mixed;
-    } else {
-      // Never silently painted: the input colour stays (MeshLab's default white when none).
-      for (int c = 0; c < 4; ++c)
-        r.colors_rgba[4 * v + size_t(c)] = input.mesh_colors.size() == 4 * n ? input.mesh_colors[4 * v + size_t(c)] : 255;
-      if (e.n_seen == 0) ++r.vertices_unseen; else ++r.vertices_no_diffuse;
-    }
-  }
-  r.attributes = result_attributes(records, !r.fits.empty());  // by name, in the schema's file order
-}
-
-std::string build_report(const FitInput &input, const FitSettings &settings, const FitResult &r) {
-  const MeshView &mesh = input.mesh;
-  const size_t n = mesh.vertex_count;
-  const GatherStats &g = r.gather;
-  std::ostringstream rep;
-  rep << "filter_vertex_brdf report\n";
-  for (const std::string &w : r.warnings) rep << w << "\n";
-  rep << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
-      << r.normals_source << "\n"
-      << (r.memory_note.empty() ? std::string() : r.memory_note + "\n")
-      << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
-      << "lights against the photos (predicted irradiance vs brightness): "
-      << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
-      << "visibility back end: " << r.visibility_backend << "\n"
-      << color_report(r, settings)
-      << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
-      << ", T_d (N.L) = " << settings.gather.diffuse_threshold << "\n"
-      << "vertices coloured: " << r.vertices_coloured << " (" << percent(r.vertices_coloured, n) << ")\n"
-      << "  of which from mixed pixels only (silhouette/border/contact; coloured = 2): " << r.vertices_from_mixed << "\n"
-      << "vertices seen but without a usable sample (kept their colour): " << r.vertices_no_diffuse << "\n"
-      << "vertices seen by no photo (skipped, kept their colour; need another viewpoint): " << r.vertices_unseen << "\n"
-      << "vertex-photo pairs: " << g.pairs << ", samples stored (seen): " << g.stored << "\n";
-  const std::pair<uint16_t, const char *> flag_names[] = {
-      {kOffImage, "off image / behind camera"}, {kBackFacing, "back-facing"}, {kOccluded, "occluded"},
-      {kAttachedShadow, "facing away from the light"}, {kCastShadow, "in cast shadow"},
-      {kSaturated, "saturated (not used)"},
-      {kMixedPixel, "mixed pixel at a silhouette/contact, no own-surface texel (used only where nothing else is: fit_status 4)"},
-      {kRimFootprint, "rim footprint: colour from its own-surface texels (used where the vertex has < 2 clean samples)"},
-      {kGrazing, "grazing light (N.L < T_d)"}, {kHighlight, "highlight (R.E > T_s)"}};
-  for (const auto &f : flag_names)
-    rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
-  rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
-  if (!r.fits.empty()) {
-    rep << "Phong fit back end: " << r.fit_backend << "\n"
-        << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
-        << "  diffuse-only (k_s = 0; k_s/alpha stages skipped: fewer than " << settings.phong.min_specular_samples
-        << " clean highlight samples and fewer than " << settings.phong.min_lobe_samples
-        << " samples with R.E > " << settings.phong.lobe_threshold << ", or no specular term): " << r.fit_diffuse_only << "\n"
-        << "  from weak samples only (grazing N.L < T_d and/or mixed pixels; fit_status 4): " << r.fit_weak << "\n"
-        << "  from neighbours (no usable sample of their own; fit_status 3): " << r.fit_neighbours << "\n"
-        << "  no model (sentinels: k_d = k_s = shininess = 0; unseen, or no modelled neighbour): " << r.fit_none << "\n"
-        << "  converged before the cap of " << settings.phong.max_iterations << " iterations: " << r.fit_converged
-        << " of " << r.fit_full << " full fits; alpha iterations run: " << r.fit_iterations << " of at most "
-        << uint64_t(r.fit_full + r.fit_diffuse_only) * uint64_t(std::max(0, settings.phong.max_iterations)) << "\n";
-    rep << (settings.materials ? r.materials.report : "materials: off (per-vertex lobes only)\n");
-  } else {
-    rep << "Phong fit: off (basic diffuse colour only)\n";
-  }
-  // What skipping saved, estimated from the measured rates (the skipped work was never run).
-  const double per_pair = r.seconds_gather > 0 && g.stored ? (r.seconds_gather - r.seconds_fit) / double(g.stored) : 0;
-  rep << "skipped work (estimated saving): " << g.rasters_skipped << " raster x chunk pairs not read; "
-      << (g.pairs - g.stored) << " vertex-photo pairs not sampled (not seen), ~"
-      << fixed(per_pair * double(g.pairs - g.stored), 2) << " s";
-  if (!r.fits.empty()) {
-    const uint64_t fitted = r.fit_full + r.fit_diffuse_only;
-    const uint64_t cap_work = fitted * uint64_t(std::max(0, settings.phong.max_iterations));
-    // Cost model: set-up of a vertex ~ 2 iterations (tests/bench/FIT_PERFORMANCE.md).
-    const double per_iteration = r.seconds_fit / double(std::max<uint64_t>(1, r.fit_iterations + 2 * fitted));
-    rep << "; " << (cap_work - std::min<uint64_t>(cap_work, r.fit_iterations))
-        << " shininess iterations not run (diffuse-only or converged vertices), ~"
-        << fixed(per_iteration * double(cap_work - std::min<uint64_t>(cap_work, r.fit_iterations)), 2) << " s";
-  }
-  rep << "\n";
-  rep << "time: visibility " << fixed(r.seconds_visibility) << " s, samples " << fixed(r.seconds_gather - r.seconds_fit)
-      << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
-      << g.rasters_skipped << " raster x chunk pairs skipped)\n";
-  return rep.str();
-}
 } // namespace
-
-namespace {
-// True for GL implementations that rasterise on the CPU (Mesa llvmpipe/softpipe/swrast, lavapipe,
-// Microsoft's GDI renderer): there the compute shader runs on the same cores as the CPU fit, and
-// slower (tests/bench/FIT_PERFORMANCE.md: the CPU reference is 2.4-3.7x faster at the same error).
-bool software_renderer(const std::string &device) {
-  std::string d = device;
-  std::transform(d.begin(), d.end(), d.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  for (const char *name : {"llvmpipe", "softpipe", "swrast", "software rasterizer", "lavapipe", "gdi generic"})
-    if (d.find(name) != std::string::npos) return true;
-  return false;
-}
-} // namespace
-
-std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
-                                               const std::function<void *(const char *)> &get_proc, const LogFn &log) {
-  if (settings.fit_backend != FitBackendChoice::CPU) {
-    if (get_proc) {
-      try {
-        std::unique_ptr<GpuFitter> gpu(new GpuFitter(get_proc));
-        if (settings.fit_backend == FitBackendChoice::Auto && software_renderer(gpu->device())) {
-          std::unique_ptr<PhongFitter> cpu(new CpuFitter(
-              "Auto chose it over the compute shader: the GL context is a software renderer (" + gpu->device() + ")"));
-          log(std::string("Phong fit: ") + cpu->name() + ". Set 'fitBackend' to GPU to use the shader anyway.");
-          return cpu;
-        }
-        log(std::string("Phong fit: ") + gpu->name() + ".");
-        return std::unique_ptr<PhongFitter>(gpu.release());
-      } catch (const ProcessingError &e) {
-        if (settings.fit_backend == FitBackendChoice::GPU)
-          throw ProcessingError(std::string("'Fit back end' is set to GPU (compute shader), but ") + e.what() +
-                                " Set 'Fit back end' to Auto or CPU (reference).");
-        log(std::string("Phong fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");
-      }
-    } else if (settings.fit_backend == FitBackendChoice::GPU) {
-      throw ProcessingError("'Fit back end' is set to GPU (compute shader), but no GL context is available: set "
-                            "'Fit back end' to Auto or CPU (reference).");
-    }
-  }
-  std::unique_ptr<PhongFitter> cpu(new CpuFitter());
-  log(std::string("Phong fit: ") + cpu->name() + ".");
-  return cpu;
-}
 
 FitResult run_fit(const FitInput &input, const FitSettings &settings_in, VisibilityBackend &visibility,
                   PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {

@@ -12,6 +12,7 @@
 #include "calibration/color_chart.h"
 #include "calibration/color_plan.h"  // ColorCorrectionChoice: Off, Auto (where a chart is found), Required
 #include "samples/diffuse_color.h"
+#include "fit/fit_backends.h"  // VisibilityChoice, FitBackendChoice, PhongFitter, their factories
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
 #include "fit/materials.h"
@@ -24,10 +25,6 @@
 
 namespace vbrdf {
 
-using LogFn = std::function<void(const std::string &line)>;
-
-enum class VisibilityChoice { Auto = 0, GL = 1, CPU = 2 };
-enum class FitBackendChoice { Auto = 0, GPU = 1, CPU = 2 };
 enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
 
 // The fit's T_d (N.L below which a sample is "grazing"): 0.2, not the thesis's 0.5. With errors
@@ -115,27 +112,6 @@ struct FitResult {
   size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;
   double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
 };
-
-// Creates the visibility back end: GL when `get_proc` is given and the context supports it
-// (unless CPU is forced), else CPU. Logs which one runs and why.
-std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh, const FitSettings &settings,
-                                                           const std::function<void *(const char *)> &get_proc,
-                                                           const LogFn &log);
-
-// The per-vertex Phong fit back end (phong_fit.h): GPU compute shader or CPU reference.
-class PhongFitter {
-public:
-  virtual ~PhongFitter() = default;
-  virtual const char *name() const = 0;
-  virtual void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out) = 0;
-};
-
-// GPU when `get_proc` is given and the context has compute shaders (unless CPU is forced),
-// else CPU. Auto also takes the CPU when the GL context is a software renderer (llvmpipe and
-// the like), where the shader is slower than the CPU reference; the fitter's name (in the report)
-// says so. Logs which one runs and why. The GL context must stay current while it is used.
-std::unique_ptr<PhongFitter> make_phong_fitter(const FitSettings &settings,
-                                               const std::function<void *(const char *)> &get_proc, const LogFn &log);
 
 // Runs the pipeline and writes the PLY and the report (<ply stem>_report.txt). Nothing is
 // written if any stage fails; the two files are committed together under a lock on their folder

@@ -70,4 +70,49 @@ void check_gl_target_size(const GlApi &gl, int width, int height, const std::str
                           ". Use smaller photos or shadow map, or the CPU back end.");
 }
 
+void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
+                          const std::string &who, const std::string &what) {
+  if (t.fbo && t.width == width && t.height == height) return;
+  check_gl_target_size(gl, width, height, who, what);
+  const bool shading = kind == RenderTargetKind::ShadingAndDepth;
+  if (!t.fbo) {
+    gl.GenFramebuffers(1, &t.fbo);
+    gl.GenTextures(1, &t.color);
+    gl.GenRenderbuffers(1, &t.depth);
+  }
+  if (shading && !t.extra) gl.GenTextures(1, &t.extra);
+  gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
+  const auto texture = [&](GLuint name, GLint format, GLenum channels) {
+    gl.BindTexture(GL_TEXTURE_2D, name);
+    gl.TexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, channels, GL_FLOAT, nullptr);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  };
+  texture(t.color, shading ? GL_RGBA32F : GL_R32F, shading ? GL_RGBA : GL_RED);
+  if (shading) texture(t.extra, GL_R32F, GL_RED);
+  gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
+  gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
+  if (shading) gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, t.extra, 0);
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
+  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  gl.DrawBuffers(shading ? 2 : 1, buffers);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  check_gl_error(gl, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
+                         " render target for " + what);
+  check_framebuffer(gl, GL_FRAMEBUFFER, what);
+  t.width = width;
+  t.height = height;
+}
+
+void release_render_target(const GlApi &gl, GlRenderTarget &t) {
+  if (t.fbo) gl.DeleteFramebuffers(1, &t.fbo);
+  if (t.color) gl.DeleteTextures(1, &t.color);
+  if (t.extra) gl.DeleteTextures(1, &t.extra);
+  if (t.depth) gl.DeleteRenderbuffers(1, &t.depth);
+  t = GlRenderTarget();
+}
+
 } // namespace vbrdf

@@ -36,6 +36,23 @@ struct GlMeshFrame {
 // ("OpenGL visibility", "Relighting") starts the messages.
 GlMeshFrame gl_mesh_frame(const MeshView &mesh, float depth_tolerance_fraction, const std::string &who);
 
+// An FBO with float colour outputs and a 32F depth renderbuffer. Attachment 0 is R32F for a depth
+// pass (the linear depth) or RGBA32F for a shading pass, whose attachment 1 (`extra`) is then an
+// R32F linear depth. Names are GL object names (GLuint); 0 = not allocated.
+struct GlRenderTarget {
+  unsigned fbo = 0, color = 0, extra = 0, depth = 0;
+  int width = 0, height = 0;
+};
+enum class RenderTargetKind { LinearDepth, ShadingAndDepth };
+
+// (Re)allocates `t` at width x height unless it already has that size, after
+// check_gl_target_size; leaves it bound as the framebuffer with its colour outputs as draw buffers.
+// Throws ProcessingError naming `what` when GL cannot allocate or complete it.
+void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
+                          const std::string &who, const std::string &what);
+// Deletes the GL objects of `t` (the context must be current) and resets it.
+void release_render_target(const GlApi &gl, GlRenderTarget &t);
+
 // Throws ProcessingError ("<who>: <what> needs a WxH render target, but this OpenGL allows at most
 // ...") when the context's texture, renderbuffer or viewport limits are smaller.
 void check_gl_target_size(const GlApi &gl, int width, int height, const std::string &who, const std::string &what);

@@ -28,6 +28,8 @@ namespace vbrdf {
 
 namespace {
 
+const char *const kWho = "Relighting";  // starts its GL error messages
+
 // Shared by both passes: positions are uploaded relative to the bounding-box centre (precision of
 // far-from-origin coordinates), view depth is written for the shadow test and the comparison.
 const char *const kShadeVertexShader = R"(#version 330 core
@@ -119,11 +121,6 @@ void main() {
 
 constexpr int kFloatsPerVertex = 12;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1
 
-struct Target {
-  GLuint fbo = 0, color = 0, extra = 0, depth = 0;  // extra: the camera pass's depth output
-  int width = 0, height = 0;
-};
-
 // The shininess given to k_s = 0 vertices (see the header): median of the fitted lobes.
 float typical_shininess(const std::vector<VertexFit> &fits) {
   std::vector<float> a;
@@ -153,9 +150,6 @@ public:
 
 private:
   void upload(const MeshView &mesh, const std::vector<VertexFit> &fits);
-  void check_size(int width, int height, const std::string &what) const;
-  void ensure_target(Target &t, int width, int height, bool camera, const std::string &what);
-  void release_target(Target &t);
   void release();
   void shadow_pass(const LightView &lv);
   void camera_pass(const Shot &shot, const LightSource &light, const LightView &lv, RelitImage &out);
@@ -168,7 +162,7 @@ private:
   float corners_[8][3] = {};
   float radius_ = 0, tolerance_ = 0;
   GLuint shade_program_ = 0, shadow_program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
-  Target camera_target_, shadow_target_;
+  GlRenderTarget camera_target_, shadow_target_;
 };
 
 RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc,
@@ -177,7 +171,7 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   if (fits.size() != mesh.vertex_count)
     throw InputError("Relighting: " + std::to_string(fits.size()) + " per-vertex fits for a mesh of " +
                      std::to_string(mesh.vertex_count) + " vertices: use the fit of this mesh.");
-  const GlMeshFrame frame = gl_mesh_frame(mesh, settings.depth_tolerance, "Relighting");
+  const GlMeshFrame frame = gl_mesh_frame(mesh, settings.depth_tolerance, kWho);
   std::copy(frame.origin, frame.origin + 3, origin_);
   std::copy(&frame.corners[0][0], &frame.corners[0][0] + 24, &corners_[0][0]);
   radius_ = frame.radius;
@@ -190,7 +184,7 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
   try {
-    check_size(settings_.shadow_map_size, settings_.shadow_map_size, "the shadow map");
+    check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the shadow map");
     shade_program_ = build_program(gl_, kShadeVertexShader, kShadeFragmentShader, "the relighting pass");
     shadow_program_ = build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map");
     upload(mesh, fits);
@@ -236,55 +230,9 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
                  GL_STATIC_DRAW);
 }
 
-void RelightRenderer::Impl::check_size(int width, int height, const std::string &what) const {
-  check_gl_target_size(gl_, width, height, "Relighting", what);
-}
-
-void RelightRenderer::Impl::ensure_target(Target &t, int width, int height, bool camera, const std::string &what) {
-  if (t.fbo && t.width == width && t.height == height) return;
-  check_size(width, height, what);
-  if (!t.fbo) {
-    gl_.GenFramebuffers(1, &t.fbo);
-    gl_.GenTextures(1, &t.color);
-    if (camera) gl_.GenTextures(1, &t.extra);
-    gl_.GenRenderbuffers(1, &t.depth);
-  }
-  gl_.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
-  auto texture = [&](GLuint name, GLint format, GLenum channels) {
-    gl_.BindTexture(GL_TEXTURE_2D, name);
-    gl_.TexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, channels, GL_FLOAT, nullptr);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
-  };
-  texture(t.color, camera ? GL_RGBA32F : GL_R32F, camera ? GL_RGBA : GL_RED);
-  if (camera) texture(t.extra, GL_R32F, GL_RED);
-  gl_.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
-  gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-  gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-  gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
-  if (camera) gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, t.extra, 0);
-  gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-  const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  gl_.DrawBuffers(camera ? 2 : 1, buffers);
-  check_gl_error(gl_, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
-                          " render target for " + what);
-  check_framebuffer(gl_, GL_FRAMEBUFFER, what);
-  t.width = width;
-  t.height = height;
-}
-
-void RelightRenderer::Impl::release_target(Target &t) {
-  if (t.fbo) gl_.DeleteFramebuffers(1, &t.fbo);
-  if (t.color) gl_.DeleteTextures(1, &t.color);
-  if (t.extra) gl_.DeleteTextures(1, &t.extra);
-  if (t.depth) gl_.DeleteRenderbuffers(1, &t.depth);
-  t = Target();
-}
-
 void RelightRenderer::Impl::release() {
-  release_target(camera_target_);
-  release_target(shadow_target_);
+  release_render_target(gl_, camera_target_);
+  release_render_target(gl_, shadow_target_);
   if (vao_) gl_.DeleteVertexArrays(1, &vao_);
   if (vbo_) gl_.DeleteBuffers(1, &vbo_);
   if (ibo_) gl_.DeleteBuffers(1, &ibo_);
@@ -301,7 +249,7 @@ void RelightRenderer::Impl::draw() {
 // The light's view (light_view.h, shared with the visibility pass).
 void RelightRenderer::Impl::shadow_pass(const LightView &lv) {
   const int size = settings_.shadow_map_size;
-  ensure_target(shadow_target_, size, size, false, "the relighting shadow map");
+  ensure_render_target(gl_, shadow_target_, size, size, RenderTargetKind::LinearDepth, kWho, "the relighting shadow map");
   Mat4 view, projection;
   std::copy(lv.view, lv.view + 16, view.m);
   std::copy(lv.projection, lv.projection + 16, projection.m);
@@ -322,7 +270,7 @@ void RelightRenderer::Impl::shadow_pass(const LightView &lv) {
 void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &light, const LightView &lv,
                                         RelitImage &out) {
   const int width = shot.Intrinsics.ViewportPx[0], height = shot.Intrinsics.ViewportPx[1];
-  ensure_target(camera_target_, width, height, true, "the relighting camera pass");
+  ensure_render_target(gl_, camera_target_, width, height, RenderTargetKind::ShadingAndDepth, kWho, "the relighting camera pass");
   // View matrix on recentred positions: the translation R (origin - C) in double.
   Mat4 view;
   gl_view_matrix(shot, view.m);

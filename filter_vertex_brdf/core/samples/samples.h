@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "base/callbacks.h"  // ProgressFn
 #include "inputs/camera.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
@@ -91,9 +92,6 @@ struct VisibilityMasks {
   bool sees_any(size_t r, size_t first, size_t count) const;
 };
 
-// Progress: fraction in [0,1] and a short label. Returns false to cancel (core then throws
-// ProcessingError("cancelled")).
-using ProgressFn = std::function<bool(float fraction, const char *stage)>;
 
 // Runs the camera and light depth passes for every raster. lights[r] is the light of raster r.
 VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,

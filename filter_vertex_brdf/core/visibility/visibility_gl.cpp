@@ -19,6 +19,8 @@ namespace vbrdf {
 
 namespace {
 
+const char *const kWho = "OpenGL visibility";  // starts its GL error messages
+
 // Background value: farther than anything, so vertices next to the mesh silhouette stay clear.
 const float kFarAway = FLT_MAX;
 
@@ -54,12 +56,6 @@ inline uint8_t footprint_code(const float *map, int w, int h, float ix, float iy
   return camera_code_of(mask);
 }
 
-// An FBO with an R32F colour texture (linear depth) and a 32F depth renderbuffer.
-struct DepthTarget {
-  GLuint fbo = 0, color = 0, depth = 0;
-  int width = 0, height = 0;
-};
-
 class GlVisibility : public VisibilityBackend {
 public:
   GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_proc, const VisibilitySettings &settings);
@@ -69,12 +65,9 @@ public:
   void light_pass(const LightSource &light, uint8_t *out) override;
 
 private:
-  void check_target_size(int width, int height, const std::string &what) const;
   void upload_mesh();
-  void ensure_target(DepthTarget &target, int width, int height, const std::string &what);
-  void release_target(DepthTarget &target);
   void release_gl();
-  void render_depth(const DepthTarget &target, const Mat4 &view, const Mat4 &projection, const std::string &what);
+  void render_depth(const GlRenderTarget &target, const Mat4 &view, const Mat4 &projection, const std::string &what);
   void fill(uint8_t *out, uint8_t value) const;
 
   MeshView mesh_;
@@ -86,19 +79,19 @@ private:
   float tolerance_ = 0;          // settings.depth_tolerance * bbox diagonal (world units)
   GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
   GLint u_view_ = -1, u_projection_ = -1;
-  DepthTarget camera_target_, light_target_;
+  GlRenderTarget camera_target_, light_target_;
   std::vector<float> depth_;     // read-back buffer, reused between passes
 };
 
 GlVisibility::GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_proc, const VisibilitySettings &settings)
     : mesh_(mesh), settings_(settings), gl_(load_gl_api(get_proc)) {
-  const GlMeshFrame frame = gl_mesh_frame(mesh, settings.depth_tolerance, "OpenGL visibility");
+  const GlMeshFrame frame = gl_mesh_frame(mesh, settings.depth_tolerance, kWho);
   std::copy(frame.origin, frame.origin + 3, origin_);
   std::copy(&frame.corners[0][0], &frame.corners[0][0] + 24, &corners_[0][0]);
   radius_ = frame.radius;
   tolerance_ = frame.tolerance;
   settings_.shadow_map_size = resolved_shadow_map_size(mesh, settings);
-  check_target_size(settings_.shadow_map_size, settings_.shadow_map_size, "the light-view shadow map");
+  check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the light-view shadow map");
 
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);  // errors left by the host are not ours
@@ -117,17 +110,13 @@ GlVisibility::GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_pro
 GlVisibility::~GlVisibility() { release_gl(); }
 
 void GlVisibility::release_gl() {
-  release_target(camera_target_);
-  release_target(light_target_);
+  release_render_target(gl_, camera_target_);
+  release_render_target(gl_, light_target_);
   if (vao_) gl_.DeleteVertexArrays(1, &vao_);
   if (vbo_) gl_.DeleteBuffers(1, &vbo_);
   if (ibo_) gl_.DeleteBuffers(1, &ibo_);
   if (program_) gl_.DeleteProgram(program_);
   vao_ = vbo_ = ibo_ = program_ = 0;
-}
-
-void GlVisibility::check_target_size(int width, int height, const std::string &what) const {
-  check_gl_target_size(gl_, width, height, "OpenGL visibility", what);
 }
 
 void GlVisibility::upload_mesh() {
@@ -150,45 +139,9 @@ void GlVisibility::upload_mesh() {
                  GL_STATIC_DRAW);
 }
 
-void GlVisibility::ensure_target(DepthTarget &t, int width, int height, const std::string &what) {
-  if (t.fbo && t.width == width && t.height == height) return;
-  check_target_size(width, height, what);
-  if (!t.fbo) {
-    gl_.GenFramebuffers(1, &t.fbo);
-    gl_.GenTextures(1, &t.color);
-    gl_.GenRenderbuffers(1, &t.depth);
-  }
-  gl_.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
-  gl_.BindTexture(GL_TEXTURE_2D, t.color);
-  gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width, height, 0, GL_RED, GL_FLOAT, nullptr);
-  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
-  gl_.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
-  gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-  gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-  gl_.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.color, 0);
-  gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.depth);
-  const GLenum draw_buffer = GL_COLOR_ATTACHMENT0;
-  gl_.DrawBuffers(1, &draw_buffer);
-  gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  check_gl_error(gl_, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
-                          " render target for " + what);
-  check_framebuffer(gl_, GL_FRAMEBUFFER, what);
-  t.width = width;
-  t.height = height;
-}
-
-void GlVisibility::release_target(DepthTarget &t) {
-  if (t.fbo) gl_.DeleteFramebuffers(1, &t.fbo);
-  if (t.color) gl_.DeleteTextures(1, &t.color);
-  if (t.depth) gl_.DeleteRenderbuffers(1, &t.depth);
-  t = DepthTarget();
-}
-
 // Renders the nearest linear depth into `t` and reads it back into depth_ (GL row order: row 0 is
 // the bottom of the image). The caller holds a GlStateGuard.
-void GlVisibility::render_depth(const DepthTarget &t, const Mat4 &view, const Mat4 &projection,
+void GlVisibility::render_depth(const GlRenderTarget &t, const Mat4 &view, const Mat4 &projection,
                                 const std::string &what) {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl_.Viewport(0, 0, t.width, t.height);
@@ -255,7 +208,7 @@ void GlVisibility::camera_pass(const Shot &shot, uint8_t *out) {
   {
     GlStateGuard guard(gl_);
     clear_gl_errors(gl_);
-    ensure_target(camera_target_, width, height, "the camera depth pass");
+    ensure_render_target(gl_, camera_target_, width, height, RenderTargetKind::LinearDepth, kWho, "the camera depth pass");
     render_depth(camera_target_, view, projection, "the camera depth pass");
   }
 
@@ -303,7 +256,7 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
   {
     GlStateGuard guard(gl_);
     clear_gl_errors(gl_);
-    ensure_target(light_target_, size, size, "the light-view shadow map");
+    ensure_render_target(gl_, light_target_, size, size, RenderTargetKind::LinearDepth, kWho, "the light-view shadow map");
     render_depth(light_target_, view, projection, "the light-view shadow map pass");
   }
   const float *map = depth_.data();

@@ -107,11 +107,10 @@ int main(int argc, char **argv) {
         log(std::string("OSMesa context unavailable: ") + e.what());
       }
     }
-    auto visibility = make_visibility_backend(input.mesh, settings,
-                                              settings.visibility_choice == VisibilityChoice::CPU ? nullptr : get_proc, log);
+    auto visibility = make_visibility_backend(input.mesh, settings.visibility_choice, settings.visibility, get_proc, log);
     std::unique_ptr<PhongFitter> fitter;
     if (settings.fit_reflectance)
-      fitter = make_phong_fitter(settings, settings.fit_backend == FitBackendChoice::CPU ? nullptr : get_proc, log);
+      fitter = make_phong_fitter(settings.fit_backend, get_proc, log);
     run_fit(input, settings, *visibility, fitter.get(), {}, log);
     return 0;
   } catch (const InputError &e) {

@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Sample-gathering benchmark (issue: foundation): 100k vertices x 32 photos at 1024x768, GL
 # (llvmpipe) and CPU back ends, and how the time grows with photos and vertices.
-# Usage: tests/bench/run_gather_benchmark.sh BUILD_DIR [OUT_CSV]
+# Usage: tests/benchmark/run_gather_benchmark.sh BUILD_DIR [OUT_CSV]
 set -euo pipefail
 BUILD=${1:?build dir}
-OUT=${2:-$BUILD/bench/gather.csv}
-WORK=$BUILD/bench/scenes
+OUT=${2:-$BUILD/benchmark/gather.csv}
+WORK=$BUILD/benchmark/scenes
 mkdir -p "$WORK" "$(dirname "$OUT")"
 synth=$BUILD/tests/tools/synthesize_scene
-bench=$BUILD/tests/bench/bench_gather
+bench=$BUILD/tests/benchmark/bench_gather
 for v in 10000 30000 100000; do
   [ -f "$WORK/v$v/project.mlp" ] || "$synth" --out "$WORK/v$v" --vertices $v --width 1024 --height 768 --lights 32 --heldout 0 --ss 1 --quiet
 done
