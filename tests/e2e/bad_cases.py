@@ -21,6 +21,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 import e2e_lib as lib
+import run_e2e
 
 FILTER = "Vertex BRDF: fit per-vertex reflectance"
 
@@ -49,8 +50,7 @@ class Context:
 
     def rasters(self):
         """[(label, photo path as written)]."""
-        root = ET.parse(self.mlp).getroot()
-        return [(r.get("label"), r.find("Plane").get("fileName")) for r in root.iter("MLRaster")]
+        return run_e2e.rasters(self.mlp)
 
     def photo(self, i):
         return os.path.join(self.proj_dir, self.rasters()[i][1])

@@ -215,6 +215,12 @@ def check_sane_output(out_ply, mesh, min_coloured):
     return failures
 
 
+def rasters(mlp):
+    """[(label, photo path as written)] of an .mlp (also used by tests/calib_e2e)."""
+    root = ET.parse(mlp).getroot()
+    return [(r.get("label"), r.find("Plane").get("fileName")) for r in root.iter("MLRaster")]
+
+
 def project_copy(a):
     """A fresh work folder with a copy of a.project's folder (without earlier results); returns
     (work, source folder, its checksums, copy)."""
