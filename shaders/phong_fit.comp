@@ -23,8 +23,8 @@ layout(local_size_x = 64) in;
 struct Sample {  // core/samples/samples.h Sample, 24 bytes
   float r, g, b;
   float d;             // N.L
-  float s;             // R.E
-  uint raster_flags;   // raster | flags << 16
+  float s;             // the lobe's cosine: R.E or N.H (samples/lobe.h)
+  uint raster_flags;   // raster | flags << 16 | resolution << 26
 };
 
 struct Fit {  // core/fit/phong_fit.h VertexFit, 40 bytes
@@ -45,15 +45,16 @@ uniform uint u_sample_base;   // offsets[0]: the samples buffer starts at this s
 uniform float u_alpha_init, u_alpha_min, u_alpha_max, u_tolerance, u_weight_cap, u_prior;
 uniform float u_kd_max, u_ks_max, u_specular_threshold;
 uniform int u_max_iterations, u_min_specular, u_min_lobe;
-uniform float u_lobe_threshold;
+uniform float u_lobe_threshold;  // both thresholds already on the lobe's cosine (lobe_threshold())
+uniform int u_half_angle_lobe;   // 1: s is N.H (SQ's sampling term is then 2 s^2 - 1, lobe_as_r_dot_e)
 
 const uint kUnusable = 0x13Fu;  // kNotSeen | kShadowed | kSaturated | kMixedPixel (samples.h)
 const uint kStatusDiffuseOnly = 1u, kStatusFull = 2u;
 
 struct Obs {
   vec3 p;      // pixel value / g_pixel_scale
-  float d, s;  // min(N.L, 1), R.E
-  float w;     // N.L / g_weight_scale, times g_high_scale for highlight samples
+  float d, s;  // min(N.L, 1), the lobe's cosine
+  float w;     // N.L * resolution weight / g_weight_scale, times g_high_scale for highlight samples
   bool high;
 };
 
@@ -96,7 +97,8 @@ float lobe(float s, float alpha) {
 bool load(uint i, out Obs x) {
   const Sample raw = samples[i - u_sample_base];
   x.p = vec3(0.0); x.d = 0.0; x.s = 0.0; x.w = 0.0; x.high = false;
-  const uint flags = raw.raster_flags >> 16;
+  const uint flags = (raw.raster_flags >> 16) & 0x3FFu;
+  const float resolution = exp2(-float(raw.raster_flags >> 26) / 8.0);  // resolution_weight()
   if ((flags & kUnusable) != 0u) return false;
   // Grazing light (kGrazing) is not evidence unless the sample is a highlight (kHighlight).
   if ((flags & 0x40u) != 0u && (flags & 0x80u) == 0u) return false;
@@ -107,7 +109,7 @@ bool load(uint i, out Obs x) {
   x.p = vec3(raw.r, raw.g, raw.b) * g_inv_pixel_scale;
   x.d = min(raw.d, 1.0);
   x.s = raw.s;
-  x.w = raw.d * g_inv_weight_scale * (x.high ? g_high_scale : 1.0);
+  x.w = raw.d * resolution * g_inv_weight_scale * (x.high ? g_high_scale : 1.0);
   return true;
 }
 
@@ -308,7 +310,8 @@ void quality_metrics(inout Fit f) {
     const vec3 diff = x.p - evaluate(f, x.d, x.s) * g_inv_pixel_scale;
     const float err2 = dot(diff, diff);  // scaled; * p2 in pixel units (may be +Inf: clamped below)
     e += x.w * err2, w += x.w;
-    if (x.high) sq_term += x.s, sq_err += x.s * err2 * p2 / 3.0, ++ns;
+    const float s_re = u_half_angle_lobe != 0 ? (x.s > 0.0 ? 2.0 * x.s * x.s - 1.0 : -1.0) : x.s;
+    if (x.high) sq_term += s_re, sq_err += s_re * err2 * p2 / 3.0, ++ns;
     else dq_term += x.d, dq_err += x.d * err2 * p2 / 3.0, ++nd;
   }
   f.dq = nd > 0 ? clamp(dq_term / float(nd) + 1.0 - min(1.0, dq_err / float(nd)), 0.0, 2.0) : 0.0;

@@ -1,5 +1,6 @@
 #include "coverage_filter.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -50,25 +51,10 @@ std::vector<vbrdf::VertexAttribute> coverage_attributes(const vbrdf::CoverageRes
 QString CoverageFilter::name() const { return "Vertex BRDF: coverage and next light"; }
 
 QString CoverageFilter::info() const {
-  return "Acquisition feedback between two shots: which vertices the photos taken so far cover, and where "
-         "to put the light next (thesis 4.4.1, 4.5, 4.7). Works with any number of registered photos "
-         "(raster layers), even one; photos of one viewpoint share one registration (identical camera).<br><br>"
-         "Every vertex is classified and coloured: <b>purple</b> not seen by any photo (needs another "
-         "viewpoint), <b>red</b> seen but without a diffuse sample (lit, N&middot;L above the diffuse "
-         "threshold, no highlight, unsaturated), <b>yellow</b> diffusely covered but without a specular "
-         "sample (an unsaturated highlight, R&middot;E above the specular threshold), <b>green</b> fully "
-         "covered. Counts and percentages go to the log.<br><br>"
-         "For the viewpoint of the chosen raster (by default the last one) the filter suggests the next "
-         "light for diffuse coverage and the next for specular coverage (per-vertex ideal lights, "
-         "Algorithms 1 and 3, gathered in 36&times;36 latitude/longitude bins and chosen greedily, "
-         "Algorithm 2), each with the number of uncovered vertices it would cover, as azimuth and "
-         "elevation in the camera frame (azimuth 0 = right, 90 = up; elevation 90 = at the camera) and as "
-         "a unit vector. Lights below the camera-facing horizon or behind the object are never suggested. "
-         "Vertices that only a new viewpoint can cover are selected and listed in a file. When the mesh "
-         "carries a fit's DQ/SQ (from \"Vertex BRDF: fit per-vertex reflectance\"), covered vertices with "
-         "a poor fit also ask for samples.<br><br>"
-         "Suggestions are written to a text file beside the project (key: value lines and the report). "
-         "Light directions of the photos come from an <i>.lp</i> file.";
+  // Short on purpose (see FitFilter::info); the details are in the README and the tooltips.
+  return "Acquisition feedback: which vertices the photos so far cover (<b>purple</b> unseen, <b>blue</b> no "
+         "diffuse sample, <b>yellow</b> no specular sample, <b>green</b> covered) and where to put the light next "
+         "(log and a text file). Vertices only a new viewpoint can cover are selected.";
 }
 
 MeshFilterInterface::FilterClass CoverageFilter::filterClass() const {
@@ -79,16 +65,20 @@ int CoverageFilter::requirements() const { return MeshModel::MM_VERTCOLOR; }
 
 int CoverageFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
 
-int CoverageFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTFLAGSELECT; }
+// MM_VERTNUMBER: no Preview in MeshLab 2020.09 (see FitFilter::postConditions): a preview would
+// rewrite the suggestion file on every change of a field.
+int CoverageFilter::postConditions() const {
+  return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTFLAGSELECT | MeshModel::MM_VERTNUMBER;
+}
 
 void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
   shared::add_light_file(params);
   shared::add_light_placement(params);
-  params.addParam(RichSaveFile(
-      kSuggestionFile, "", "Text (*.txt)", "Suggestion file",
+  add_path(
+      params, kSuggestionFile, "Suggestion file",
       "Where the suggestions are written (key: value lines, then the report); the vertices only a new "
       "viewpoint can cover go beside it (same name ending in _new_view_vertices.txt). Relative paths are "
-      "relative to the project folder. Empty: the project's name followed by _next_light.txt, beside it."));
+      "relative to the project folder. Empty: the project's name followed by _next_light.txt, beside it.");
   shared::add_viewpoint_raster(params);
   shared::add_specular_threshold(params);
   shared::add_diffuse_threshold(params, shared::DiffuseThresholdUse::Coverage);
@@ -107,19 +97,22 @@ void CoverageFilter::initParameters(const MeshDocument &, RichParameterList &par
   params.addParam(RichFloat(kPoorSpecularQuality, 1.5f, "Poor specular quality (SQ)",
                             "SQ (in [0, 2], 2 = good) below which a covered vertex asks for more specular samples."));
   params.addParam(RichBool(kColorByCoverage, true, "Colour vertices by coverage",
-                           "Vertex colours show the classes: purple unseen, red no diffuse sample, yellow no "
-                           "specular sample, green fully covered (replaces the current vertex colours)."));
+                           "Vertex colours show the classes: purple unseen, blue no diffuse sample, yellow no "
+                           "specular sample, green fully covered. The classes are also kept in the per-vertex attributes coverage_class "
+                           "and coverage_color; 'Vertex BRDF: show vertex colours' switches back to the colours before "
+                           "(or to the fit's). Off: the vertex colours are not changed."));
   params.addParam(RichBool(kSelectNewView, true, "Select vertices needing a new viewpoint",
                            "Select exactly the vertices that no photo sees or that no placeable light of any "
                            "registered viewpoint can cover."));
   shared::add_photo_and_visibility(params);
+  shared::add_only_selected(params);
 }
 
 vbrdf::CoverageSettings CoverageFilter::settings_from(const RichParameterList &params) {
   vbrdf::CoverageSettings s;
   s.light_file = shared::light_file(params);
   shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
-  s.suggestion_file = utf8(params.getSaveFileName(kSuggestionFile));
+  s.suggestion_file = path(params, kSuggestionFile);
   s.viewpoint_raster = shared::viewpoint_raster(params);
   shared::read_gather(params, s.gather);
   shared::read_visibility(params, s.visibility_choice, s.visibility);
@@ -141,6 +134,7 @@ CoverageFilter::Display CoverageFilter::display_from(const RichParameterList &pa
   display.color_by_class = params.getBool(kColorByCoverage);
   display.select_new_view = params.getBool(kSelectNewView);
   display.use_fit_quality = params.getBool(kUseFitQuality);
+  display.only_selected = shared::only_selected(params);
   return display;
 }
 
@@ -160,12 +154,22 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
   vbrdf::CoverageInput input;
   input.mesh = arrays.data.view();
   input.mesh_name = mesh->label().toUtf8().toStdString();
-  input.rasters = document_rasters(run.document);
+  const ActiveRasters active = active_rasters(run.document);
+  input.rasters = active.rasters;
+  shared::log_hidden_rasters(active.hidden, active.rasters.size(), log);
+  if (display.only_selected) input.vertex_mask = shared::selection_mask(*mesh, arrays, log);
   input.project_path = project_path(run.document, *mesh);
   settings.light_file = resolve_path(settings.light_file, input.project_path);
   settings.suggestion_file = resolve_path(settings.suggestion_file, input.project_path);
-  if (settings.viewpoint_raster < 0 && !run.document.rasterList.empty())
-    settings.viewpoint_raster = int(shared::chosen_raster(run.document, -1));  // the current raster
+  if (!run.document.rasterList.empty()) {
+    // viewpointRaster counts the document's rasters; the core counts the visible ones.
+    const size_t chosen = shared::chosen_raster(run.document, settings.viewpoint_raster);
+    const auto at = std::find(active.document_index.begin(), active.document_index.end(), chosen);
+    require(at != active.document_index.end(), shared::kViewpointRaster,
+            "names raster " + std::to_string(chosen) + " ('" + utf8(run.document.rasterList[int(chosen)]->label()) +
+                "'), which is hidden: show it in the layer dialog or choose a visible raster");
+    settings.viewpoint_raster = int(at - active.document_index.begin());
+  }
   if (display.use_fit_quality) {
     input.dq = vertex_float_attribute(*mesh, arrays, "dq");
     input.sq = vertex_float_attribute(*mesh, arrays, "sq");
@@ -182,8 +186,13 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
     result = vbrdf::run_coverage(input, settings, *visibility, progress_adapter(run.progress, "Vertex BRDF coverage: "),
                                  log);
   }
-  store_results(*mesh, arrays, display.color_by_class ? result.colors_rgba : std::vector<uint8_t>(),
-                std::vector<float>(), coverage_attributes(result));
+  StoredResults stored;
+  stored.layer = ColorLayer::Coverage;
+  stored.colors_rgba = result.colors_rgba;  // kept in coverage_color; shown only when asked
+  stored.paint = display.color_by_class;
+  stored.attributes = coverage_attributes(result);
+  stored.vertex_mask = input.vertex_mask;
+  store_results(*mesh, arrays, stored);
   if (display.select_new_view) select_vertices(*mesh, arrays, result.new_view_vertices);
   return result;
 }

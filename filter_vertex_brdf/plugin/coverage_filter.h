@@ -29,8 +29,9 @@ public:
     bool color_by_class = true;     // vertex colours = coverage classes
     bool select_new_view = true;    // select the vertices only a new viewpoint can cover
     bool use_fit_quality = true;    // take DQ/SQ from the mesh's "dq"/"sq" attributes when present
+    bool only_selected = false;     // only the selected vertices are considered and changed
   };
-  // The display parameters (colorByCoverage, selectNewViewVertices, useFitQuality).
+  // The display parameters (colorByCoverage, selectNewViewVertices, useFitQuality, onlySelectedVertices).
   static Display display_from(const RichParameterList &params);
   // Runs the coverage on the current mesh and every raster of the document (paths in `settings`
   // relative to the project folder; viewpoint_raster -1 = the document's current raster) and

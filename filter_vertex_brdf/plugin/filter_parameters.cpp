@@ -31,6 +31,28 @@ std::vector<float> parse_corners(const QString &text, const char *param) {
   return values;
 }
 
+void add_path(RichParameterList &params, const char *name, const QString &label, const QString &tooltip) {
+  params.addParam(RichString(name, "", label, tooltip + " Type or paste the path (absolute, or relative to the project folder)."));
+}
+
+std::string path(const RichParameterList &params, const char *name) {
+  const Value &value = params.getParameterByName(name).value();
+  if (value.isFileName()) return utf8(value.getFileName().trimmed());
+  require(value.isString(), name, "must be a path (text)");
+  return utf8(value.getString().trimmed());
+}
+
+std::string with_labels(const std::string &message, const RichParameterList &params) {
+  std::string out = message;
+  for (const RichParameter &p : params) {
+    const std::string quoted = "'" + utf8(p.name()) + "'";
+    const std::string labelled = "'" + utf8(p.fieldDescription()) + "' [" + utf8(p.name()) + "]";
+    for (size_t at = out.find(quoted); at != std::string::npos; at = out.find(quoted, at + labelled.size()))
+      out.replace(at, quoted.size(), labelled);
+  }
+  return out;
+}
+
 namespace shared {
 
 const char *const kLightFile = "lightFile";
@@ -53,6 +75,7 @@ const char *const kOutputLightFile = "outputLightFile";
 const char *const kColorCorrection = "colorCorrection";
 const char *const kChartCorners = "chartCorners";
 const char *const kExposureNormalisation = "exposureNormalisation";
+const char *const kOnlySelected = "onlySelectedVertices";
 
 namespace {
 
@@ -68,15 +91,15 @@ int enum_value(const RichParameterList &params, const char *name, int count, con
 // --- Light file ---------------------------------------------------------------------------------
 
 void add_light_file(RichParameterList &params) {
-  params.addParam(RichOpenFile(
-      kLightFile, "", QStringList("Light files (*.lp *.json *.dome)"), "Light file (.lp, .json, .dome)",
+  add_path(
+      params, kLightFile, "Light file (.lp, .json, .dome)",
       "Each photo's light. RTI .lp: first line the number of photos, then one line per photo: image file name "
       "and the unit direction towards the light (x right, y up, z towards the camera): distant lights, or "
       "lights on a dome with 'Dome radius'. Near lights (a dome, a flash or a lamp within a few object sizes): "
       ".json with \"images\" and \"position_world\" (mesh frame and units) or \"position_camera\" (each "
       "photo's camera frame), or a Relight .dome (cm: set 'Light unit scale'). Photos are matched by file "
       "name. Empty: the most recently modified *.lp beside the project or the photos that has an entry for "
-      "every raster (the rule of every Vertex BRDF filter)."));
+      "every raster (the rule of every Vertex BRDF filter).");
 }
 
 void add_light_placement(RichParameterList &params) {
@@ -98,7 +121,7 @@ void read_light_placement(const RichParameterList &params, float &dome_radius, f
   require(std::isfinite(unit_scale) && unit_scale >= 0, kLightUnitScale, "must be 0 (not given) or positive");
 }
 
-std::string light_file(const RichParameterList &params) { return utf8(params.getOpenFileName(kLightFile)); }
+std::string light_file(const RichParameterList &params) { return path(params, kLightFile); }
 
 // --- Sample classification and photos -----------------------------------------------------------
 
@@ -211,6 +234,35 @@ int min_specular_samples(const RichParameterList &params) {
   return n;
 }
 
+// --- Only on selection --------------------------------------------------------------------------
+
+void add_only_selected(RichParameterList &params) {
+  params.addParam(RichBool(kOnlySelected, false, "Only on selection",
+                           "Work on the selected vertices only (as MeshLab's colour projection): the others take no "
+                           "sample and keep their colours, quality and attributes in the document; in the fit's "
+                           "PLY they have no model (fit_status 0). Off: every vertex."));
+}
+
+bool only_selected(const RichParameterList &params) { return params.getBool(kOnlySelected); }
+
+std::vector<uint8_t> selection_mask(const MeshModel &mesh, const MeshArrays &arrays,
+                                    const std::function<void(const std::string &)> &log) {
+  size_t count = 0;
+  std::vector<uint8_t> mask = selected_vertices(mesh, arrays, count);
+  require(count > 0, kOnlySelected,
+          "is on but no vertex of '" + utf8(mesh.label()) + "' is selected: select vertices (Edit > Select "
+          "Vertices, or Filters > Selection) or turn it off");
+  log("Vertex BRDF: only on selection: " + std::to_string(count) + " of " + std::to_string(mask.size()) +
+      " vertices take part.");
+  return mask;
+}
+
+void log_hidden_rasters(size_t hidden, size_t used, const std::function<void(const std::string &)> &log) {
+  if (hidden == 0) return;
+  log("Vertex BRDF: " + std::to_string(hidden) + " hidden raster(s) left out (only visible rasters take part, as in "
+      "MeshLab's colour projection); " + std::to_string(used) + " used.");
+}
+
 // --- Viewpoint ----------------------------------------------------------------------------------
 
 void add_viewpoint_raster(RichParameterList &params) {
@@ -267,17 +319,17 @@ void add_output_light_file(RichParameterList &params, OutputLightFileUse use) {
   const QString common = "Where the estimated light directions are written (RTI .lp: image name and unit direction "
                          "towards the light, x right, y up, z towards the camera), replacing the file atomically. "
                          "Relative paths are relative to the project folder. ";
-  params.addParam(RichSaveFile(
-      kOutputLightFile, "", "Light positions (*.lp)", "Output light file (.lp)",
+  add_path(
+      params, kOutputLightFile, "Output light file (.lp)",
       common + (use == OutputLightFileUse::Sphere
                     ? "Entries of other viewpoints' rasters already in it are kept. Empty: the project's name "
                       "followed by _sphere.lp, beside the project (sphere lights only)."
                     : "Sphere mode only: every entry of the light file above is kept. Empty: the project's name "
-                      "followed by _lights.lp, beside the project (the acquisition's lights so far).")));
+                      "followed by _lights.lp, beside the project (the acquisition's lights so far)."));
 }
 
 std::string output_light_file(const RichParameterList &params) {
-  return utf8(params.getSaveFileName(kOutputLightFile));
+  return path(params, kOutputLightFile);
 }
 
 std::string default_output_light_file(const std::string &project, OutputLightFileUse use) {

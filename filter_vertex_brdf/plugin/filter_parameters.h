@@ -18,6 +18,7 @@
 // asks the photographer for well-lit samples) and outputLightFile (the sphere filter writes
 // <project>_sphere.lp, sphere lights only; the import writes <project>_lights.lp, the existing .lp
 // merged with the new lights).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,7 @@
 #include "core/samples/samples.h"
 #include "core/calibration/sphere_lights.h"
 #include "core/visibility/visibility.h"
+#include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
 
@@ -39,6 +41,22 @@ void require(bool ok, const char *param, const std::string &what);
 // Throws InputError naming `param` for a word that is no finite number or a count not a multiple
 // of 8.
 std::vector<float> parse_corners(const QString &text, const char *param);
+
+// --- File paths ---------------------------------------------------------------------------------
+// MeshLab 2020.09's file fields (RichOpenFile, RichSaveFile) drop a typed path: their widget
+// (IOFileWidget in meshlab/rich_parameter_gui/richparameterwidgets.cpp) hands back only the name the
+// "..." browser returned, never the text in its line edit, and it shows no tooltip. Every path
+// parameter is therefore a string field: what the user types or pastes is what the filter gets.
+// The tooltip says so ("type or paste the path").
+void add_path(RichParameterList &params, const char *name, const QString &label, const QString &tooltip);
+// The path as given ("" when empty; not resolved). Reads the string the dialog produces and also
+// the file value (RichOpenFile/RichSaveFile) of an .mlx script written before the change.
+std::string path(const RichParameterList &params, const char *name);
+
+// `message` with every quoted parameter name ('lightFile') replaced by its dialog label and the
+// name ('Light file (.lp, .json, .dome)' [lightFile]), so that messages name fields as the user
+// sees them in the dialog and scripts can still find the name.
+std::string with_labels(const std::string &message, const RichParameterList &params);
 
 namespace shared {
 
@@ -102,6 +120,17 @@ int shadow_map_size(const RichParameterList &params);
 // --- Coverage and fit ---------------------------------------------------------------------------
 void add_min_specular_samples(RichParameterList &params);
 int min_specular_samples(const RichParameterList &params);  // in [1, 1000]
+
+// --- Only on selection (fit, coverage) ----------------------------------------------------------
+extern const char *const kOnlySelected;  // "onlySelectedVertices", labelled as MeshLab's colour projection
+void add_only_selected(RichParameterList &params);
+bool only_selected(const RichParameterList &params);
+// The selection as a vertex mask (per array vertex); logs how many vertices take part. Throws
+// InputError naming the field when no vertex is selected.
+std::vector<uint8_t> selection_mask(const MeshModel &mesh, const MeshArrays &arrays,
+                                    const std::function<void(const std::string &)> &log);
+// Logs how many rasters are hidden and so left out (nothing when none is).
+void log_hidden_rasters(size_t hidden, size_t used, const std::function<void(const std::string &)> &log);
 
 // --- Viewpoint (coverage, sphere) ---------------------------------------------------------------
 // -1 = MeshLab's current raster (else the last one), or a raster index from 0.

@@ -5,9 +5,12 @@
 
 #include "core/base/errors.h"
 #include "coverage_filter.h"
+#include "filter_parameters.h"
 #include "fit_filter.h"
 #include "import_photos_filter.h"
+#include "load_result_filter.h"
 #include "relight_filter.h"
+#include "show_colors_filter.h"
 #include "sphere_filter.h"
 
 using vbrdf_plugin::PluginFilter;
@@ -19,6 +22,8 @@ FilterVertexBrdfPlugin::FilterVertexBrdfPlugin() {
   filters_.emplace_back(new vbrdf_plugin::SphereFilter());
   filters_.emplace_back(new vbrdf_plugin::CoverageFilter());
   filters_.emplace_back(new vbrdf_plugin::ImportPhotosFilter());
+  filters_.emplace_back(new vbrdf_plugin::LoadResultFilter());
+  filters_.emplace_back(new vbrdf_plugin::ShowColorsFilter());
 
   for (size_t id = 0; id < filters_.size(); ++id) {
     typeList << FilterIDType(id);
@@ -80,6 +85,8 @@ bool FilterVertexBrdfPlugin::applyFilter(QAction *action, MeshDocument &md, cons
   } catch (const std::exception &e) {
     failure = std::string("unexpected error: ") + e.what();
   }
+  // Fields named as the dialog labels them (the .mlx name in brackets).
+  failure = vbrdf_plugin::with_labels(failure, params);
   errorMessage = QString::fromStdString(failure);
   // meshlabserver never prints errorMsg(), only the log: put the reason there too so that
   // headless runs say why they failed (the GUI shows errorMessage in its failure dialog).

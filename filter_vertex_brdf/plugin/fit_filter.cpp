@@ -5,7 +5,6 @@
 #include <sstream>
 
 #include "core/base/errors.h"
-#include "core/io/result_schema.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"
 
@@ -20,6 +19,7 @@ const char *const kOverwriteOutput = "overwriteOutput";
 const char *const kFitReflectance = "fitReflectance";
 const char *const kFitBackend = "fitBackend";
 const char *const kInitialShininess = "initialShininess";
+const char *const kSpecularLobe = "specularLobe";
 const char *const kMaxIterations = "maxIterations";
 const char *const kFillUnseenRings = "fillUnseenRings";
 const char *const kQualityOutput = "qualityOutput";
@@ -40,32 +40,11 @@ std::string color_summary(const vbrdf::FitSettings &settings, const vbrdf::FitRe
 QString FitFilter::name() const { return "Vertex BRDF: fit per-vertex reflectance"; }
 
 QString FitFilter::info() const {
-  return "Fits a Phong reflectance model (colour C, diffuse k<sub>d</sub>, specular k<sub>s</sub>, "
-         "shininess &alpha;) to every vertex from the registered photos of the project (the raster layers), "
-         "each taken under a different, known light direction (an RTI/photometric-stereo capture; several "
-         "viewpoints may be mixed).<br><br>"
-         "Light directions are read from an <i>.lp</i> file (RTIBuilder/Relight format: one line per photo, "
-         "<code>image lx ly lz</code>, direction towards the light in the camera frame). For each vertex "
-         "and photo the filter tests visibility from the camera and cast shadows from the light (OpenGL "
-         "depth passes, or a CPU ray cast), samples the photo, and discards shadowed, grazing "
-         "(N&middot;L below the diffuse threshold), specular (R&middot;E above the specular threshold) and "
-         "saturated samples for a first diffuse colour, then fits f = k<sub>d</sub> (N&middot;L) C + "
-         "k<sub>s</sub> (R&middot;E)<sup>&alpha;</sup> to all lit, unsaturated samples (weighted by N&middot;L; "
-         "on the GPU with a compute shader when MeshLab's OpenGL context allows, else on the CPU). Vertices "
-         "with too little specular evidence get a diffuse-only fit (k<sub>s</sub> = 0).<br><br>"
-         "Results: vertex colours become the fitted albedo (sRGB; vertices no photo sees keep their "
-         "colour), vertex quality the chosen fit quality, the per-vertex values are stored as float "
-         "attributes (" + QString::fromStdString(vbrdf::result_attribute_names()) + "; diffuse_r/g/b = "
-         "k<sub>d</sub> C) and written with the geometry to a PLY, plus a text "
-         "report beside it. The mesh geometry is not changed. The mesh needs per-vertex normals; photos "
-         "must be undistorted.<br><br>"
-         "Colour correction: when a 24-patch ColorChecker is in the photos of a viewpoint (detected, or "
-         "located by its corner patches), a colour correction fitted to the chart (3x3 matrix, tone curve + "
-         "matrix or per-channel polynomial, whichever predicts held-out patches best) is applied to every "
-         "sample in linear space before the fit, and the photos' exposure is normalised by the chart's neutral "
-         "patches (per photo when the light intensity varies). The albedo is then a reflectance in linear sRGB "
-         "without the camera's colour cast. Without a chart the reflectance is known up to one global scale "
-         "(unknown light intensity and exposure) and the camera's colours.";
+  // Short on purpose: MeshLab 2020.09 puts this text above the fields, and a long one pushes Apply
+  // off a 1000-pixel screen. The details are in the README and in each field's tooltip / Help.
+  return "Fits Phong reflectance (colour, k<sub>d</sub>, k<sub>s</sub>, shininess) to every vertex from the visible "
+         "registered photos and their lights; colours the mesh with the albedo and writes a PLY with every "
+         "per-vertex value and a report. Hover over a field, or press Help, for what it does.";
 }
 
 MeshFilterInterface::FilterClass FitFilter::filterClass() const {
@@ -76,16 +55,21 @@ int FitFilter::requirements() const { return MeshModel::MM_VERTCOLOR | MeshModel
 
 int FitFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
 
-int FitFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY; }
+// MM_VERTNUMBER: MeshLab 2020.09 then offers no Preview (MeshlabStdDialog::isPreviewable), as for
+// its own filters that return MM_ALL: a preview would re-run the whole fit and write the PLY on
+// every change of a field. (The vertices are not changed; MeshLab only refreshes its buffers.)
+int FitFilter::postConditions() const {
+  return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY | MeshModel::MM_VERTNUMBER;
+}
 
 void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
   shared::add_light_file(params);
   shared::add_light_placement(params);
-  params.addParam(RichSaveFile(
-      kOutputPly, "", "PLY (*.ply)", "Output PLY",
+  add_path(
+      params, kOutputPly, "Output PLY",
       "Where the mesh with the per-vertex results is written (binary PLY with float properties), with a "
       "report beside it (same name ending in _report.txt). Relative paths are relative to the "
-      "project folder. Empty: the project's name followed by _brdf.ply, beside the project."));
+      "project folder. Empty: the project's name followed by _brdf.ply, beside the project.");
   params.addParam(RichBool(kOverwriteOutput, true, "Overwrite existing output",
                            "On: an existing output PLY and report are replaced (atomically: the previous files "
                            "stay intact until the new ones are complete) and the log says so. Off: the filter "
@@ -105,6 +89,14 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   params.addParam(RichFloat(kInitialShininess, vbrdf::PhongFitOptions().alpha_init, "Initial shininess",
                             "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
                             "the highlight samples and keeps the better one). Range [1, 2000]."));
+  params.addParam(RichEnum(kSpecularLobe, int(vbrdf::kFitLobe),
+                           QStringList() << "Phong on R.E (thesis)" << "Blinn-Phong on N.H",
+                           "Specular lobe",
+                           "What the shininess is the exponent of: the cosine between the mirrored light and "
+                           "the view (R.E, the thesis's Phong) or between the normal and the half vector "
+                           "(N.H, Blinn-Phong; follows glossy highlights seen away from the camera axis "
+                           "better). Written with the result (per-vertex lobe_form) and used by every "
+                           "later step (relighting, evaluation)."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
@@ -121,13 +113,14 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "thesis's diffuse or specular quality (0..2, higher is better) or the weighted "
                            "fit RMSE (lower is better)."));
   shared::add_color_correction(params);
+  shared::add_only_selected(params);
 }
 
 vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   vbrdf::FitSettings s;
   s.light_file = shared::light_file(params);
   shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
-  s.output_ply = utf8(params.getSaveFileName(kOutputPly));
+  s.output_ply = path(params, kOutputPly);
   s.overwrite = params.getBool(kOverwriteOutput) ? vbrdf::OverwritePolicy::Replace : vbrdf::OverwritePolicy::Refuse;
   shared::read_gather(params, s.gather);
   shared::read_visibility(params, s.visibility_choice, s.visibility);
@@ -140,6 +133,8 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(iterations >= 0 && iterations <= 10000, kMaxIterations, "must be in [0, 10000]");
   const int fill_rings = params.getInt(kFillUnseenRings);
   require(fill_rings >= 0 && fill_rings <= 1000, kFillUnseenRings, "must be in [0, 1000]");
+  const int lobe = params.getEnum(kSpecularLobe);
+  require(lobe >= 0 && lobe <= 1, kSpecularLobe, "must be 0 (Phong on R.E) or 1 (Blinn-Phong on N.H)");
   const int quality = params.getEnum(kQualityOutput);
   require(quality >= 0 && quality <= 2, kQualityOutput, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
 
@@ -147,6 +142,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.fit_backend = vbrdf::FitBackendChoice(fit_backend);
   s.phong.alpha_init = alpha0;
   s.phong.max_iterations = iterations;
+  s.phong.lobe = vbrdf::LobeForm(lobe);
   s.phong.min_specular_samples = shared::min_specular_samples(params);
   s.fill_unseen_rings = fill_rings;
   s.quality = vbrdf::QualityOutput(quality);
@@ -172,7 +168,10 @@ void FitFilter::apply(FilterRun &run) const {
   input.mesh_name = mesh->label().toUtf8().toStdString();
   input.mesh_path = mesh->fullName().toUtf8().toStdString();
   input.mesh_colors = arrays.data.colors;
-  input.rasters = document_rasters(run.document);
+  const ActiveRasters active = active_rasters(run.document);
+  input.rasters = active.rasters;
+  shared::log_hidden_rasters(active.hidden, active.rasters.size(), log);
+  if (shared::only_selected(run.params)) input.vertex_mask = shared::selection_mask(*mesh, arrays, log);
   input.project_path = project_path(run.document, *mesh);
   settings.light_file = resolve_path(settings.light_file, input.project_path);
   settings.output_ply = resolve_path(settings.output_ply, input.project_path);
@@ -193,8 +192,13 @@ void FitFilter::apply(FilterRun &run) const {
     result = vbrdf::run_fit(input, settings, *visibility, fitter.get(), progress_adapter(run.progress, "Vertex BRDF: "),
                             log);
   }
-  store_results(*mesh, arrays, result.colors_rgba, settings.fit_reflectance ? result.quality : std::vector<float>(),
-                result.attributes);
+  StoredResults stored;
+  stored.layer = ColorLayer::Fit;
+  stored.colors_rgba = std::move(result.colors_rgba);
+  if (settings.fit_reflectance) stored.quality = std::move(result.quality);
+  stored.attributes = std::move(result.attributes);
+  stored.vertex_mask = input.vertex_mask;
+  store_results(*mesh, arrays, stored);
 
   std::ostringstream summary;
   summary << "Vertex BRDF: " << result.vertices_coloured << " of " << arrays.vertex_index.size()

@@ -167,7 +167,11 @@ int ImportPhotosFilter::requirements() const { return MeshModel::MM_VERTCOLOR; }
 
 int ImportPhotosFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
 
-int ImportPhotosFilter::postConditions() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTFLAGSELECT; }
+// MM_VERTNUMBER: no Preview in MeshLab 2020.09 (see FitFilter::postConditions): a preview would add
+// the rasters and write the light file at every change of a field.
+int ImportPhotosFilter::postConditions() const {
+  return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTFLAGSELECT | MeshModel::MM_VERTNUMBER;
+}
 
 void ImportPhotosFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
   params.addParam(RichString(kPhotoFiles, "", "Photo files",

@@ -100,20 +100,44 @@ MeshArrays mesh_arrays(const MeshModel &mesh) {
   return out;
 }
 
+namespace {
+
+vbrdf::Raster raster_of(const RasterModel &rm) {
+  vbrdf::Raster r;
+  r.label = utf8(rm.label());
+  if (rm.planeList.empty() || rm.planeList.first() == nullptr)
+    throw vbrdf::InputError("Raster '" + r.label + "' has no image: add its photo (a <Plane fileName=...> in the "
+                            ".mlp) or remove the raster.");
+  // The first plane is the photo (MeshLab's .mlp reader keeps only the first).
+  r.image_path = utf8(rm.planeList.first()->fullPathFileName);
+  r.shot = rm.shot;  // Shotm is vcg::Shot<float> with MESHLAB_SCALAR=float
+  return r;
+}
+
+} // namespace
+
 std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document) {
   std::vector<vbrdf::Raster> rasters;
-  for (const RasterModel *rm : document.rasterList) {
-    vbrdf::Raster r;
-    r.label = utf8(rm->label());
-    if (rm->planeList.empty() || rm->planeList.first() == nullptr)
-      throw vbrdf::InputError("Raster '" + r.label + "' has no image: add its photo (a <Plane fileName=...> in the "
-                              ".mlp) or remove the raster.");
-    // The first plane is the photo (MeshLab's .mlp reader keeps only the first).
-    r.image_path = utf8(rm->planeList.first()->fullPathFileName);
-    r.shot = rm->shot;  // Shotm is vcg::Shot<float> with MESHLAB_SCALAR=float
-    rasters.push_back(r);
-  }
+  for (const RasterModel *rm : document.rasterList) rasters.push_back(raster_of(*rm));
   return rasters;
+}
+
+ActiveRasters active_rasters(const MeshDocument &document) {
+  ActiveRasters active;
+  for (int i = 0; i < document.rasterList.size(); ++i) {
+    const RasterModel *rm = document.rasterList[i];
+    if (!rm->visible) {
+      ++active.hidden;
+      continue;
+    }
+    active.rasters.push_back(raster_of(*rm));
+    active.document_index.push_back(size_t(i));
+  }
+  if (active.rasters.empty() && active.hidden > 0)
+    throw vbrdf::InputError("Every raster (" + std::to_string(active.hidden) + ") is hidden in the layer dialog: only "
+                            "visible rasters take part, as in MeshLab's colour projection. Show the rasters to use "
+                            "(the eye beside each raster layer).");
+  return active;
 }
 
 std::string project_path(const MeshDocument &document, const MeshModel &mesh) {
@@ -142,31 +166,88 @@ std::string resolve_path(const std::string &path, const std::string &project) {
   return utf8(QDir::cleanPath(base.absoluteFilePath(p)));
 }
 
-void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint8_t> &colors_rgba,
-                   const std::vector<float> &quality, const std::vector<vbrdf::VertexAttribute> &attributes) {
+const char *color_layer_attribute(ColorLayer layer) {
+  switch (layer) {
+  case ColorLayer::Input: return kInputColorAttribute;
+  case ColorLayer::Fit: return "vbrdf_fit_color";
+  default: return "coverage_color";
+  }
+}
+
+const char *color_layer_label(ColorLayer layer) {
+  switch (layer) {
+  case ColorLayer::Input: return "the colours before any Vertex BRDF filter";
+  case ColorLayer::Fit: return "the fitted albedo";
+  default: return "the coverage classes";
+  }
+}
+
+namespace {
+
+// The colour attribute `name`, created (or re-created when a same-named attribute has another type).
+CMeshO::PerVertexAttributeHandle<vcg::Color4b> color_attribute(CMeshO &cm, const char *name) {
+  if (!ColorAlloc::IsValidHandle(cm, ColorAlloc::FindPerVertexAttribute<vcg::Color4b>(cm, name)) &&
+      vcg::tri::HasPerVertexAttribute(cm, name))
+    ColorAlloc::DeletePerVertexAttribute(cm, name);
+  return ColorAlloc::GetPerVertexAttribute<vcg::Color4b>(cm, name);
+}
+
+} // namespace
+
+void store_results(MeshModel &mesh, const MeshArrays &arrays, const StoredResults &results) {
   CMeshO &cm = mesh.cm;
   const size_t n = arrays.vertex_index.size();
-  if (quality.size() == n) {  // "Colorize by vertex quality" then shows it
+  const bool masked = results.vertex_mask.size() == n;
+  const auto changes = [&](size_t i) { return !masked || results.vertex_mask[i] != 0; };
+  if (results.quality.size() == n) {  // "Colorize by vertex quality" then shows it
     mesh.updateDataMask(MeshModel::MM_VERTQUALITY);
-    for (size_t i = 0; i < n; ++i) cm.vert[arrays.vertex_index[i]].Q() = quality[i];
+    for (size_t i = 0; i < n; ++i)
+      if (changes(i)) cm.vert[arrays.vertex_index[i]].Q() = results.quality[i];
   }
   mesh.updateDataMask(MeshModel::MM_VERTCOLOR);
-  if (colors_rgba.size() == 4 * n) save_input_colors_once(cm);
-  if (colors_rgba.size() == 4 * n)
+  const std::vector<uint8_t> &rgba = results.colors_rgba;
+  if (rgba.size() == 4 * n) {
+    save_input_colors_once(cm);
+    auto layer = color_attribute(cm, color_layer_attribute(results.layer));
     for (size_t i = 0; i < n; ++i) {
-      const uint8_t *c = &colors_rgba[4 * i];
-      cm.vert[arrays.vertex_index[i]].C() = vcg::Color4b(c[0], c[1], c[2], c[3]);
+      if (!changes(i)) continue;
+      const uint8_t *c = &rgba[4 * i];
+      const vcg::Color4b color(c[0], c[1], c[2], c[3]);
+      layer[arrays.vertex_index[i]] = color;
+      if (results.paint) cm.vert[arrays.vertex_index[i]].C() = color;
     }
-  for (const vbrdf::VertexAttribute &attr : attributes) {
+  }
+  for (const vbrdf::VertexAttribute &attr : results.attributes) {
     if (attr.values.size() != n || attr.name.empty()) continue;
     using Alloc = vcg::tri::Allocator<CMeshO>;
     // A same-named attribute of another type would make GetPerVertexAttribute assert.
-    if (Alloc::IsValidHandle(cm, Alloc::FindPerVertexAttribute<float>(cm, attr.name)) == false &&
-        vcg::tri::HasPerVertexAttribute(cm, attr.name))
-      Alloc::DeletePerVertexAttribute(cm, attr.name);
+    const bool exists = Alloc::IsValidHandle(cm, Alloc::FindPerVertexAttribute<float>(cm, attr.name));
+    if (!exists && vcg::tri::HasPerVertexAttribute(cm, attr.name)) Alloc::DeletePerVertexAttribute(cm, attr.name);
     auto handle = Alloc::GetPerVertexAttribute<float>(cm, attr.name);
-    for (size_t i = 0; i < n; ++i) handle[arrays.vertex_index[i]] = attr.values[i];
+    if (!exists)
+      for (size_t v = 0; v < cm.vert.size(); ++v) handle[v] = 0.0f;
+    for (size_t i = 0; i < n; ++i)
+      if (changes(i)) handle[arrays.vertex_index[i]] = attr.values[i];
   }
+}
+
+bool show_color_layer(MeshModel &mesh, ColorLayer layer) {
+  CMeshO &cm = mesh.cm;
+  const char *name = color_layer_attribute(layer);
+  auto handle = ColorAlloc::FindPerVertexAttribute<vcg::Color4b>(cm, name);
+  if (!ColorAlloc::IsValidHandle(cm, handle)) return layer == ColorLayer::Input;
+  mesh.updateDataMask(MeshModel::MM_VERTCOLOR);
+  for (size_t v = 0; v < cm.vert.size(); ++v)
+    if (!cm.vert[v].IsD()) cm.vert[v].C() = handle[v];
+  return true;
+}
+
+std::vector<uint8_t> selected_vertices(const MeshModel &mesh, const MeshArrays &arrays, size_t &count) {
+  std::vector<uint8_t> mask(arrays.vertex_index.size(), 0);
+  count = 0;
+  for (size_t i = 0; i < mask.size(); ++i)
+    if (mesh.cm.vert[arrays.vertex_index[i]].IsS()) mask[i] = 1, ++count;
+  return mask;
 }
 
 GlContextScope::GlContextScope(MLPluginGLContext *context, const std::function<void(const std::string &)> &log) {

@@ -29,6 +29,17 @@ MeshArrays mesh_arrays(const MeshModel &mesh);
 // Throws vbrdf::InputError naming a raster without image.
 std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document);
 
+// The rasters the fit and the coverage use: the visible ones (the eye in MeshLab's layer dialog),
+// as MeshLab's own "Project active rasters color to current mesh" takes them. document_index[i] is
+// the document's raster index of rasters[i]; `hidden` counts those left out. Throws InputError
+// naming a visible raster without image.
+struct ActiveRasters {
+  std::vector<vbrdf::Raster> rasters;
+  std::vector<size_t> document_index;
+  size_t hidden = 0;
+};
+ActiveRasters active_rasters(const MeshDocument &document);
+
 // The .mlp of the document when it has one, else the mesh file (its folder is used for the
 // default .lp search and output path). May be empty for a mesh never saved.
 std::string project_path(const MeshDocument &document, const MeshModel &mesh);
@@ -44,11 +55,34 @@ std::string canonical_path(const std::string &path);
 // the process's working directory, which meshlabserver changes while loading). "" stays "".
 std::string resolve_path(const std::string &path, const std::string &project_path);
 
-// Sets the mesh's per-vertex colours (enabling the colour attribute), its vertex quality when
-// `quality` has one value per vertex (enabling the quality attribute), and stores every attribute
-// as a float per-vertex attribute of the same name.
-void store_results(MeshModel &mesh, const MeshArrays &arrays, const std::vector<uint8_t> &colors_rgba,
-                   const std::vector<float> &quality, const std::vector<vbrdf::VertexAttribute> &attributes);
+// Per-vertex colour layers the filters keep beside the displayed colours, so that the user can
+// switch between them ("Vertex BRDF: show vertex colours") and no filter's colours leak into
+// another's output: the colours before any Vertex BRDF filter painted the mesh (saved once, at the
+// first paint), the last fit's albedo, the last coverage's classes. Each is a vcg::Color4b
+// per-vertex attribute of the name color_layer_attribute() gives.
+enum class ColorLayer { Input, Fit, Coverage };
+const char *color_layer_attribute(ColorLayer layer);  // "vbrdf_input_color", "vbrdf_fit_color", "coverage_color"
+const char *color_layer_label(ColorLayer layer);      // for messages: "the colours before Vertex BRDF", ...
+
+// What a filter stores on the mesh. Only vertices with vertex_mask[i] != 0 change when the mask is
+// given (one entry per array vertex; "only selected vertices"); new attributes start at 0 elsewhere.
+struct StoredResults {
+  ColorLayer layer = ColorLayer::Fit;
+  std::vector<uint8_t> colors_rgba;  // RGBA8 per array vertex, kept in the layer's attribute; empty: none
+  bool paint = true;                 // also show them as the vertex colours
+  std::vector<float> quality;        // vertex quality when it has one value per vertex
+  std::vector<vbrdf::VertexAttribute> attributes;  // float per-vertex attributes, by name
+  std::vector<uint8_t> vertex_mask;  // empty: every vertex
+};
+// Stores `results` in the mesh (enabling the colour and quality attributes as needed). The input
+// colours are saved before the first paint.
+void store_results(MeshModel &mesh, const MeshArrays &arrays, const StoredResults &results);
+// Copies the colour layer onto the vertex colours. False (mesh unchanged) when the mesh has no
+// such layer. The input layer, when never saved, is the current colours: nothing to do, true.
+bool show_color_layer(MeshModel &mesh, ColorLayer layer);
+
+// Per array vertex: 1 when the vertex is selected in MeshLab, else 0; `count` gets the number.
+std::vector<uint8_t> selected_vertices(const MeshModel &mesh, const MeshArrays &arrays, size_t &count);
 
 // Makes MeshLab's plugin GL context current for its lifetime and gives its get-proc-address.
 // Without a context (or if it cannot be made current) get_proc() is empty: CPU visibility.

@@ -44,8 +44,8 @@ using Settings = RelightFilter::Settings;
 
 RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &params) {
   Settings s;
-  s.fit_result_ply = utf8(params.getOpenFileName(kFitResultPly));
-  s.raster_project = utf8(params.getOpenFileName(kRasterProject));
+  s.fit_result_ply = path(params, kFitResultPly);
+  s.raster_project = path(params, kRasterProject);
   s.light_file = shared::light_file(params);
   shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
   s.output_folder = utf8(params.getString(kOutputFolder));
@@ -78,7 +78,7 @@ RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &pa
 namespace {
 
 // The fit filter's per-vertex float attributes, read by name through the result schema.
-std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays) {
+std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays, vbrdf::LobeForm &lobe) {
   using Alloc = vcg::tri::Allocator<CMeshO>;
   vbrdf::ResultColumns columns;
   for (const vbrdf::ResultAttribute &a : vbrdf::result_schema()) {
@@ -93,13 +93,14 @@ std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &
                             "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit Phong reflectance' on) "
                             "first, or set 'fitResultPly' to the PLY it wrote.");
   std::vector<vbrdf::VertexFit> fits;
-  for (const vbrdf::VertexRecord &record : vbrdf::records_from_columns(columns, utf8(mesh.label())))
-    fits.push_back(record.fit);
+  const std::vector<vbrdf::VertexRecord> records = vbrdf::records_from_columns(columns, utf8(mesh.label()));
+  for (const vbrdf::VertexRecord &record : records) fits.push_back(record.fit);
+  lobe = vbrdf::lobe_form_of(records, utf8(mesh.label()));
   return fits;
 }
 
 // Fits of a saved result PLY, which must be this mesh (same vertices in the same order).
-std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays) {
+std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays, vbrdf::LobeForm &lobe) {
   const vbrdf::ResultPly result = vbrdf::read_result_ply(path);
   const std::vector<float> &p = arrays.data.positions, &q = result.mesh.positions;
   const float tolerance = 1e-4f * std::max(1e-12f, vbrdf::compute_bounds(arrays.data.view()).diagonal());
@@ -109,7 +110,7 @@ std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const Mesh
     throw vbrdf::InputError("The fit result '" + path + "' has " + std::to_string(q.size() / 3) +
                             " vertices that do not match the current mesh (" + std::to_string(p.size() / 3) +
                             " vertices): choose the PLY the fit wrote for this mesh, or clear 'fitResultPly'.");
-  return vbrdf::fits_from_result(result, path);
+  return vbrdf::fits_from_result(result, path, &lobe);
 }
 
 struct RasterSet {
@@ -193,23 +194,11 @@ void render_novel_view(vbrdf::RelightRenderer &renderer, const RasterSet &set, c
 QString RelightFilter::name() const { return "Vertex BRDF: relight and compare"; }
 
 QString RelightFilter::info() const {
-  return "Renders the per-vertex Phong reflectance fitted by <i>Vertex BRDF: fit per-vertex reflectance</i> "
-         "(f = k<sub>d</sub> (N&middot;L) C + k<sub>s</sub> (R&middot;E)<sup>&alpha;</sup>, evaluated per pixel "
-         "with interpolated normals and parameters, cast shadows from a shadow map, directional light of unit "
-         "irradiance as in the fit) with OpenGL, and compares it with the photos.<br><br>"
-         "<b>Every raster</b>: each raster's camera under its light (from the .lp). For each raster an image "
-         "<i>model | photo | CIEDE2000 heat map</i> is written, plus a contact sheet of all of them and a table "
-         "(relight_table.csv: mean, median and 95th-percentile CIEDE2000 and PSNR over the lit visible pixels: lit "
-         "in the render, not at a silhouette or depth jump, no clipped photo channel; beside it the same over the whole "
-         "surface: every lit or unfitted surface pixel, silhouettes included, unfitted surface predicted black, no "
-         "clipped photo channel). Use 'Raster project' to "
-         "score photos the fit did not use (held-out lights), which measures how well the model relights.<br><br>"
-         "<b>Novel view</b>: the camera of one raster orbited around the mesh centre and moved closer or farther, "
-         "lit from a direction you give in that camera's frame (x right, y up, z towards the viewer, as in .lp "
-         "files); written as novel_view.png.<br><br>"
-         "Reads the per-vertex attributes the fit stored on the mesh (kd, ks, shininess, color_r/g/b, fit_status) "
-         "or a result PLY the fit wrote. Vertices without a fit are shown dark magenta. The mesh is not changed. "
-         "Needs OpenGL 3.3.";
+  // Short on purpose (see FitFilter::info); the details are in the README and the tooltips.
+  return "Renders the fitted per-vertex Phong model (the attributes the fit stored, or its PLY) with OpenGL for "
+         "every raster's camera and light, or a novel view, and compares it with the photos: images, a contact "
+         "sheet and a table of CIEDE2000 and PSNR in the output folder. The mesh is not changed. Hover over a "
+         "field, or press Help, for what it does.";
 }
 
 MeshFilterInterface::FilterClass RelightFilter::filterClass() const {
@@ -221,13 +210,13 @@ int RelightFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
 int RelightFilter::postConditions() const { return MeshModel::MM_NONE; }
 
 void RelightFilter::initParameters(const MeshDocument &, RichParameterList &params) const {
-  params.addParam(RichOpenFile(kFitResultPly, "", QStringList("PLY (*.ply)"), "Fit result (.ply)",
+  add_path(params, kFitResultPly, "Fit result (.ply)",
                                "A PLY written by the fit filter for this mesh. Empty: the per-vertex attributes the "
-                               "fit stored on the current mesh in this session."));
-  params.addParam(RichOpenFile(kRasterProject, "", QStringList("MeshLab project (*.mlp)"), "Raster project (.mlp)",
+                               "fit stored on the current mesh in this session.");
+  add_path(params, kRasterProject, "Raster project (.mlp)",
                                "Render the rasters of this project instead of the document's, e.g. the held-out "
                                "photos (heldout/project.mlp) to measure relighting on lights the fit never saw. "
-                               "Its mesh is ignored; its cameras must be registered to the current mesh."));
+                               "Its mesh is ignored; its cameras must be registered to the current mesh.");
   shared::add_light_file(params);
   shared::add_light_placement(params);
   params.addParam(RichString(kOutputFolder, "", "Output folder",
@@ -270,8 +259,8 @@ void RelightFilter::apply(FilterRun &run) const {
   const MeshArrays arrays = mesh_arrays(*mesh);
   const std::string project = project_path(run.document, *mesh);
   const std::vector<vbrdf::VertexFit> fits =
-      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays)
-                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays);
+      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays, s.render.lobe)
+                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays, s.render.lobe);
   const RasterSet set = rasters_to_render(run.document, *mesh, s);
   s.output_folder =
       s.output_folder.empty() ? default_output_folder(set.project) : resolve_path(s.output_folder, project);

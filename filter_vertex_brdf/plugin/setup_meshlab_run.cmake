@@ -1,6 +1,8 @@
 # Build-time script (cmake -P): a private meshlabserver that loads the built plugin.
 #   RUN_DIR/meshlab/meshlabserver      copy of SYSTEM_SERVER (a symlink would resolve to /usr/bin
 #                                      and load only the system plugins)
+#   RUN_DIR/meshlab/meshlab            copy of SYSTEM_GUI when given and present (the GUI, for
+#                                      tests/gui and trying the build without installing it)
 #   RUN_DIR/meshlab/plugins/*.so       links to every system plugin, plus PLUGIN_FILE
 #   RUN_DIR/lib/<arch>/meshlab         link to SYSTEM_LIB_DIR: the binary's RUNPATH is
 #                                      $ORIGIN/../lib/<arch>/meshlab
@@ -18,6 +20,9 @@ set(server_dir "${RUN_DIR}/meshlab")
 set(plugin_dir "${server_dir}/plugins")
 file(MAKE_DIRECTORY "${plugin_dir}")
 file(COPY "${SYSTEM_SERVER}" DESTINATION "${server_dir}")
+if(DEFINED SYSTEM_GUI AND EXISTS "${SYSTEM_GUI}")
+  file(COPY "${SYSTEM_GUI}" DESTINATION "${server_dir}")
+endif()
 
 # Rebuild the links each time: system plugins may have changed.
 file(GLOB old_links "${plugin_dir}/*")

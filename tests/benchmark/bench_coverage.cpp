@@ -12,23 +12,6 @@
 
 using namespace vbrdf;
 
-namespace {
-MeshData bumpy_sphere(size_t target_vertices) {
-  const int rings = std::max(8, int(std::sqrt(double(target_vertices) / 2)));
-  const float c[3] = {0, 0, 0};
-  MeshData m = test::make_sphere(c, 1.0f, rings, 2 * rings);
-  // Perturb normals with a deterministic bump pattern so that the normal field is not trivially smooth.
-  for (size_t v = 0; v < m.positions.size() / 3; ++v) {
-    float *n = &m.normals[3 * v];
-    const float *p = &m.positions[3 * v];
-    n[0] += 0.3f * std::sin(17 * p[1]), n[1] += 0.3f * std::sin(13 * p[2]), n[2] += 0.3f * std::sin(11 * p[0]);
-    const float l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int k = 0; k < 3; ++k) n[k] /= l;
-  }
-  return m;
-}
-} // namespace
-
 int main(int argc, char **argv) {
   size_t max_vertices = 2000000;
   std::string csv;
@@ -44,7 +27,7 @@ int main(int argc, char **argv) {
   if (out) std::fprintf(out, "vertices,kind,seconds,covered,needing\n");
   std::printf("%10s %9s %9s %9s %9s\n", "vertices", "kind", "seconds", "covered", "needing");
   for (size_t n = 10000; n <= max_vertices; n = n < max_vertices && n * 10 > max_vertices ? max_vertices : n * 10) {
-    const MeshData mesh = bumpy_sphere(n);
+    const MeshData mesh = test::make_bumpy_sphere(n);
     const size_t nv = mesh.positions.size() / 3;
     std::vector<uint8_t> visible(nv);
     for (size_t v = 0; v < nv; ++v) visible[v] = mesh.positions[3 * v + 2] > 0;

@@ -116,9 +116,9 @@ void make_scene(const Args &a, SampleChunk &chunk, std::vector<Truth> &truth) {
       Sample s{};
       s.raster = uint16_t(p);
       s.n_dot_l = dot(n, l);
-      s.r_dot_e = dot(n * (2 * s.n_dot_l) - l, e);
+      s.lobe_cos = dot(n * (2 * s.n_dot_l) - l, e);
       float clean[3];
-      true_model(truth[v], s.n_dot_l, s.r_dot_e, clean);
+      true_model(truth[v], s.n_dot_l, s.lobe_cos, clean);
       for (int c = 0; c < 3; ++c)
         s.rgb[c] = std::max(0.0f, clean[c] * (1 + a.noise * gauss(rng)) + 0.1f * a.noise * gauss(rng));
       uint16_t f = 0;
@@ -127,7 +127,7 @@ void make_scene(const Args &a, SampleChunk &chunk, std::vector<Truth> &truth) {
       if (std::max(s.rgb[0], std::max(s.rgb[1], s.rgb[2])) >= 1.0f) f |= kSaturated;
       for (float &c : s.rgb) c = std::min(c, 1.0f);
       if (s.n_dot_l > 0 && s.n_dot_l < 0.5f) f |= kGrazing;
-      if (s.r_dot_e > 0.9f) f |= kHighlight;
+      if (s.lobe_cos > 0.9f) f |= kHighlight;
       s.flags = f;
       chunk.samples.push_back(s);
     }
@@ -181,8 +181,8 @@ void score(const SampleChunk &chunk, const std::vector<Truth> &truth, const std:
       const Sample &s = chunk.samples[i];
       if (!usable(s)) continue;
       float fit[3], tru[3];
-      evaluate_phong(f, std::min(s.n_dot_l, 1.0f), s.r_dot_e, fit);
-      true_model(t, std::min(s.n_dot_l, 1.0f), s.r_dot_e, tru);
+      evaluate_phong(f, std::min(s.n_dot_l, 1.0f), s.lobe_cos, fit);
+      true_model(t, std::min(s.n_dot_l, 1.0f), s.lobe_cos, tru);
       for (int c = 0; c < 3; ++c) model_e += s.n_dot_l * double(fit[c] - tru[c]) * double(fit[c] - tru[c]);
       model_w += 3 * s.n_dot_l;
     }
@@ -262,7 +262,7 @@ int main(int argc, char **argv) {
   std::vector<Truth> truth;
   make_scene(a, chunk, truth);
   size_t highlights = 0;
-  for (const Sample &s : chunk.samples) highlights += usable(s) && s.r_dot_e > 0.9f;
+  for (const Sample &s : chunk.samples) highlights += usable(s) && s.lobe_cos > 0.9f;
   std::printf("%u vertices x %d photos: %zu samples (%.1f per vertex, %.2f usable highlights per vertex), %.0f MB\n",
               a.vertices, a.photos, chunk.samples.size(), double(chunk.samples.size()) / a.vertices,
               double(highlights) / a.vertices, chunk.samples.size() * sizeof(Sample) / 1e6);

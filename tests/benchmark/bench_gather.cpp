@@ -2,7 +2,9 @@
 // colour) on a project, for the GL back end (OSMesa llvmpipe) and the CPU ray caster, using the
 // first P photos. Prints one CSV line per run:
 //   backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples
-//   bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header] [--passes]
+//   bench_gather project.mlp [--backend gl|gl-readback|cpu|both|all] [--photos 4,8,16,32] [--csv-header] [--passes]
+// gl: depth tests in a compute shader (the fit's default); gl-readback: depth maps read back and tested
+// on the CPU; both = gl and cpu; all = the three.
 // --passes: instead, the time of one camera pass (the first raster's camera, photo size) and one
 // light pass (its light; shadow map at the automatic size the fit uses), measured on the second
 // call of each (render targets exist), after the back end's setup (upload / grid):
@@ -11,6 +13,7 @@
 // machine makes a flaky test, so the figures live here.)
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -34,13 +37,28 @@ std::vector<int> parse_list(const std::string &s) {
   for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
   return out;
 }
+// Back ends: "gl" (depth tests in a compute shader where the context has one), "gl-readback" (the
+// depth maps read back and tested on the CPU), "cpu" (the ray caster).
+const char *const kBackends[] = {"gl", "gl-readback", "cpu"};
+
+bool wanted(const std::string &asked, const std::string &backend) {
+  return asked == backend || asked == "all" || (asked == "both" && backend != "gl-readback");
+}
+
+std::unique_ptr<VisibilityBackend> make_backend(const std::string &backend, const MeshData &mesh,
+                                                test::OsMesaContext &context) {
+  VisibilitySettings settings;  // automatic shadow-map size, as the fit
+  settings.depth_tests_on_gpu = backend != "gl-readback";
+  return backend == "cpu" ? make_cpu_visibility(mesh.view(), settings)
+                          : make_gl_visibility(mesh.view(), context.get_proc_address(), settings);
+}
+
 // One camera and one light pass, timed on their second call (see the header).
 void time_passes(const std::string &backend, const MeshData &mesh, const Raster &raster, const LightSource &light,
                  test::OsMesaContext &context) {
-  const VisibilitySettings settings;  // automatic shadow-map size, as the fit
+  const VisibilitySettings settings;
   const double t0 = now();
-  auto vis = backend == "gl" ? make_gl_visibility(mesh.view(), context.get_proc_address(), settings)
-                             : make_cpu_visibility(mesh.view(), settings);
+  auto vis = make_backend(backend, mesh, context);
   const double setup = now() - t0;
   std::vector<uint8_t> out(mesh.positions.size() / 3);
   vis->camera_pass(raster.shot, out.data());
@@ -59,7 +77,7 @@ void time_passes(const std::string &backend, const MeshData &mesh, const Raster 
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: bench_gather project.mlp [--backend gl|cpu|both] [--photos 4,8,16,32] [--csv-header] "
+    std::fprintf(stderr, "usage: bench_gather project.mlp [--backend gl|gl-readback|cpu|both|all] [--photos 4,8,16,32] [--csv-header] "
                          "[--passes]\n");
     return 2;
   }
@@ -81,20 +99,19 @@ int main(int argc, char **argv) {
   test::OsMesaContext context;
   if (passes) {
     if (header) std::printf("passes,backend,vertices,width,height,shadow_map,setup_s,camera_pass_s,light_pass_s\n");
-    for (const std::string b : {std::string("gl"), std::string("cpu")})
-      if (backend == "both" || backend == b) time_passes(b, mesh, project.rasters.at(0), all_lights.at(0), context);
+    for (const std::string b : kBackends)
+      if (wanted(backend, b)) time_passes(b, mesh, project.rasters.at(0), all_lights.at(0), context);
     return 0;
   }
   if (header) std::printf("backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples\n");
-  for (const std::string b : {std::string("gl"), std::string("cpu")}) {
-    if (backend != "both" && backend != b) continue;
+  for (const std::string b : kBackends) {
+    if (!wanted(backend, b)) continue;
     for (int count : photo_counts) {
       const size_t p = std::min(size_t(count), project.rasters.size());
       std::vector<Raster> rasters(project.rasters.begin(), project.rasters.begin() + long(p));
       std::vector<LightSource> lights(all_lights.begin(), all_lights.begin() + long(p));
       const double t0 = now();
-      auto vis = b == "gl" ? make_gl_visibility(mesh.view(), context.get_proc_address(), VisibilitySettings())
-                           : make_cpu_visibility(mesh.view(), VisibilitySettings());
+      auto vis = make_backend(b, mesh, context);
       const VisibilityMasks masks = compute_visibility(mesh.view(), rasters, lights, *vis);
       const double t1 = now();
       GatherSettings gs;

@@ -3,11 +3,18 @@
 # (spot_dir24 and spot_dir24_view2: one mesh and vertex order, two cameras 45 degrees apart, each
 # with its own training and held-out photos). Each camera's project is fitted alone (16-bit linear
 # photos, colour correction off, the .lp's directions); every fit is then scored at each camera's
-# held-out photos with vbrdf_eval (RBF/PTM of the scored camera's own training photos beside it),
+# held-out photos with vbrdf_eval (RBF/PTM of the scored camera's own training photos beside it;
+# RTI cannot use another camera's photos at all). "both": one project holding every camera's
+# training photos (tests/tools/merge_projects.py), fitted once and scored at each camera,
 #   (a) over the ground-truth-visible vertices of the scored camera ("all"), and
-#   (b) over those that both fits model ("common": fit_status != 0 in both), the issue's protocol.
+#   (b) over those that every fit models ("common": fit_status != 0 in each), the issue's protocol.
 #   tests/benchmark/cross_camera_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_fit OPTIONS...]
-#   environment: VBRDF_SHARED_DIR (default <repo>/../shared), CAMERAS (default "spot_dir24 spot_dir24_view2")
+#   environment: VBRDF_SHARED_DIR (default <repo>/../shared), CAMERAS (default "spot_dir24 spot_dir24_view2"),
+#   SETS (default "all common": the vertex sets scored),
+#   CHECK_TOLERANCE (e.g. 0.05): only the "common" rows of each camera's own fit and of "both" at
+#   that camera are scored, and the script fails (exit 1) when "both" is worse than the camera's
+#   own fit by more than that fraction (whole-surface mean): adding a camera's photos must not
+#   raise the error at another camera (ctest two_cameras_add_up).
 # Prints one line per (fit, scored camera, vertex set): whole-surface and clean-pixel mean / p95.
 # Skips (exit 0) when the scenes are absent; needs /usr/bin/python3 with numpy for (b) and the lit flags.
 set -u
@@ -23,6 +30,7 @@ for c in $cameras; do
   [ -f "$shared/scenes/$c/project.mlp" ] || { echo "SKIP: $shared/scenes/$c not found"; exit 0; }
 done
 mkdir -p "$work"
+rm -f "$work/common_means.txt"
 for c in $cameras; do
   s=$shared/scenes/$c
   mkdir -p "$work/$c"
@@ -38,6 +46,15 @@ with open(sys.argv[2], "w") as f:
         f.write("".join("1" if b else "0" for b in row) + "\n")
 PY
 done
+# Every camera's photos in one project (photo names prefixed per camera), fitted once.
+mkdir -p "$work/both"
+projects=""
+for c in $cameras; do projects="$projects $shared/scenes/$c/project.mlp"; done
+/usr/bin/python3 "$repo/tests/tools/merge_projects.py" "$work/both/project" $projects > "$work/both/merge.log" 2>&1 ||
+  { echo "FAIL: merge_projects (see $work/both/merge.log)"; exit 1; }
+"$fit" "$work/both/project/project.mlp" --photo-dir "$work/both/project/linear" --color-correction off \
+    --lp "$work/both/project/lights.lp" --out "$work/both/fit.ply" "$@" > "$work/both/fit.log" 2>&1 ||
+  { echo "FAIL: vbrdf_fit on both (see $work/both/fit.log)"; exit 1; }
 # gt_vertex.ply of each scored camera with `visible` restricted to vertices every fit models.
 /usr/bin/python3 - "$work" "$shared/scenes" $cameras <<'PY'
 import sys
@@ -60,7 +77,7 @@ def split(path):
     v = np.frombuffer(data, dt, count, end).copy()
     return data[:end], v, data[end + dt.itemsize * count:]
 modelled = None
-for c in cams:
+for c in cams + ["both"]:
     _, v, _ = split(f"{work}/{c}/fit.ply")
     m = v['fit_status'] != 0
     modelled = m if modelled is None else modelled & m
@@ -69,10 +86,15 @@ for c in cams:
     v['visible'] = (v['visible'] != 0) & modelled
     open(f"{work}/{c}/gt_common.ply", 'wb').write(head + v.tobytes() + rest)
 PY
-for f in $cameras; do
+check=${CHECK_TOLERANCE:-}
+sets=${SETS:-"all common"}
+[ -n "$check" ] && sets=common
+status=0
+for f in $cameras both; do
   for c in $cameras; do
+    [ -n "$check" ] && [ "$f" != both ] && [ "$f" != "$c" ] && continue
     s=$shared/scenes/$c
-    for set in all common; do
+    for set in $sets; do
       gt=$s/gt_vertex.ply
       [ $set = common ] && gt=$work/$c/gt_common.ply
       log=$work/eval_${f}_at_${c}_$set.log
@@ -83,6 +105,20 @@ for f in $cameras; do
       clean=$(grep "clean pixels, modelled vertices only" "$log" | awk '{print $(NF-2) " / " $NF}')
       rbf=$(grep "same samples: RBF" "$log" | awk '{print $(NF-2) " / " $NF}')
       echo "fit $f scored at $c ($set): whole $whole; clean pixels of modelled vertices $clean; RBF of $c $rbf"
+      [ -z "$whole" ] && { echo "FAIL: no whole-surface figure in $log"; status=1; }
+      [ "$set" = common ] && echo "$f $c ${whole%% *}" >> "$work/common_means.txt"
     done
   done
 done
+if [ -n "$check" ]; then
+  for c in $cameras; do
+    own=$(awk -v c="$c" '$1 == c && $2 == c {print $3}' "$work/common_means.txt" | tail -1)
+    both=$(awk -v c="$c" '$1 == "both" && $2 == c {print $3}' "$work/common_means.txt" | tail -1)
+    if awk -v o="$own" -v b="$both" -v t="$check" 'BEGIN {exit !(o != "" && b != "" && b <= o * (1 + t))}'; then
+      echo "ok: at $c both cameras' fit $both, $c's own fit $own (tolerance $check)"
+    else
+      echo "FAIL: at $c both cameras' fit $both is worse than $c's own fit $own by more than $check"; status=1
+    fi
+  done
+fi
+exit $status

@@ -5,8 +5,8 @@
 
 Over the ground-truth visible vertices (gt_vertex.npz `visible`): share of glossy-material vertices
 with k_s > 0; share of diffuse-material vertices with k_s below 1 % of k_d; the median fitted
-shininess (R.E) of glossy vertices with k_s > 0 against the truth (`phong_shininess_approx` is the
-N.H exponent; the R.E exponent is about a quarter of it); and the found `material` labels against
+shininess of glossy vertices with k_s > 0 against the truth for the fit's lobe form (`lobe_form`;
+`phong_shininess_approx` is the N.H exponent; the R.E exponent is about a quarter of it); and the found `material` labels against
 the true `material_id` (vertex counts per pair). Needs numpy.
 """
 import os
@@ -34,11 +34,17 @@ def main():
     if d.any():
         print('diffuse visible vertices with k_s < 1 %% of k_d: %.1f %% of %d' % (100 * np.mean(ks[d] <= 0.01 * kd[d]), d.sum()))
     sel = g & (ks > 0)
+    # The lobe's form from the fit's per-vertex lobe_form (absent: R.E, files before issue 16).
+    nh = 'lobe_form' in fit.dtype.names and bool(np.any(fit['lobe_form'][vis] > 0.5))
     if sel.any():
         truth = float(np.median(gt['phong_shininess_approx'][g]))
         med = float(np.median(alpha[sel]))
-        print('median fitted shininess (R.E) %.1f; truth N.H %.1f, R.E about %.1f (ratio to R.E truth %.2f)'
-              % (med, truth, truth / 4, med / (truth / 4)))
+        if nh:
+            print('median fitted shininess (N.H) %.1f; truth N.H %.1f (ratio to the truth %.2f)'
+                  % (med, truth, med / truth))
+        else:
+            print('median fitted shininess (R.E) %.1f; truth N.H %.1f, R.E about %.1f (ratio to R.E truth %.2f)'
+                  % (med, truth, truth / 4, med / (truth / 4)))
     if 'material' in fit.dtype.names:
         lab = fit['material'].astype(int)
         for m in np.unique(lab[vis]):

@@ -165,13 +165,15 @@ int main(int argc, char **argv) {
   }
   try {
     const ResultPly result = read_result_ply(result_path);
-    const std::vector<VertexFit> fits = fits_from_result(result, result_path);
+    LobeForm lobe = LobeForm::PhongRE;
+    const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe);
     const MeshView mesh_view = result.mesh.view();
     const LightPlacement placement =
         light_placement_of(mesh_view, dome_radius, light_unit_scale);
     const Photos heldout = load_photos(mlp, lp, photo_dir, placement);
     Photos training;
     RelightOptions options;
+    options.gather.lobe = lobe;  // the samples' lobe cosine in the form the fit used
     if (!train_mlp.empty()) {
       training = load_photos(train_mlp, train_lp, train_photo_dir, placement);
       options.training_rasters = &training.project.rasters;
@@ -199,7 +201,9 @@ int main(int argc, char **argv) {
     std::unique_ptr<RelightRenderer> renderer;
     if (predict == "render") {
       if (!context) context.reset(new test::OsMesaContext());
-      renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address()));
+      RelightRenderSettings render_settings;
+      render_settings.lobe = lobe;
+      renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address(), render_settings));
       for (size_t r = 0; r < heldout.project.rasters.size(); ++r)
         rendered.push_back(render_as_photographed(*renderer, heldout.project.rasters[r].shot, heldout.lights[r]));
       options.rendered = &rendered;

@@ -1,8 +1,9 @@
 // vbrdf_fit: runs the filter's core pipeline on a .mlp without MeshLab (GL through OSMesa).
 //   vbrdf_fit project.mlp [--lp lights.lp|.json|.dome] [--dome-radius R] [--light-unit-scale S] [--out result.ply] [--visibility auto|gl|cpu]
-//             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048]
+//             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048] [--depth-tests gpu|cpu]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
+//             [--lobe re|nh] [--resolution-weights on|off]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -25,10 +26,11 @@ using namespace vbrdf;
 namespace {
 int usage() {
   std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--dome-radius R] [--light-unit-scale S] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
-               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--fit auto|gpu|cpu|off]\n"
+               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--depth-tests gpu|cpu] [--fit auto|gpu|cpu|off]\n"
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
-               "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n";
+               "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
+               "                 [--lobe re|nh] [--resolution-weights on|off]\n";
   return 2;
 }
 } // namespace
@@ -47,11 +49,15 @@ int main(int argc, char **argv) {
     else if (a == "--ts") settings.gather.specular_threshold = std::stof(next());
     else if (a == "--td") settings.gather.diffuse_threshold = std::stof(next());
     else if (a == "--shadow-map") settings.visibility.shadow_map_size = std::stoi(next());
+    else if (a == "--depth-tests") settings.visibility.depth_tests_on_gpu = next() != "cpu";  // gpu (default) | cpu
     else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
     else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
     else if (a == "--photo-dir") photo_dir = next();
     else if (a == "--materials") settings.materials = next() == "on";
+    else if (a == "--lobe") {
+      if (!parse_lobe_form(next(), settings.phong.lobe)) return usage();
+    } else if (a == "--resolution-weights") settings.gather.resolution_weights = next() == "on";
     else if (a == "--material-lobes-everywhere") settings.material_options.keep_full_fits = false;
     else if (a == "--no-robust-colour") settings.material_options.robust_colour = false;
     else if (a == "--max-materials") settings.material_options.max_materials = std::stoi(next());

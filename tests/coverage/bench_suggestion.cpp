@@ -21,20 +21,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-MeshData bumpy_sphere(size_t target_vertices) {
-  const int rings = std::max(8, int(std::sqrt(double(target_vertices) / 2)));
-  const float c[3] = {0, 0, 0};
-  MeshData m = test::make_sphere(c, 1.0f, rings, 2 * rings);
-  for (size_t v = 0; v < m.positions.size() / 3; ++v) {
-    float *n = &m.normals[3 * v];
-    const float *p = &m.positions[3 * v];
-    n[0] += 0.3f * std::sin(17 * p[1]), n[1] += 0.3f * std::sin(13 * p[2]), n[2] += 0.3f * std::sin(11 * p[0]);
-    const float l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int k = 0; k < 3; ++k) n[k] /= l;
-  }
-  return m;
-}
-
 // Counts as if `lights` had been photographed: covered where predicted, except a band of vertices
 // (y > shadowed_above) in "cast shadow" for every light, so that the predictions there fail.
 std::vector<CoverageCounts> simulated_counts(const MeshData &m, const Shot &shot,
@@ -96,7 +82,7 @@ int main(int argc, char **argv) {
               "new view", "total", "plain d", "plain s");
   CoverageSettings settings;
   for (size_t n = 10000; n <= max_vertices; n = n < max_vertices && n * 10 > max_vertices ? max_vertices : n * 10) {
-    const MeshData mesh = bumpy_sphere(n);
+    const MeshData mesh = test::make_bumpy_sphere(n);
     const MeshView view = mesh.view();
     std::vector<uint8_t> visible;
     const std::vector<CoverageCounts> counts = simulated_counts(mesh, vp.shot, lights, shadowed_above, visible);

@@ -38,7 +38,7 @@ import e2e_lib as lib  # noqa: E402
 COVERAGE = "Vertex BRDF: coverage and next light"
 IMPORT = "Vertex BRDF: import new photos of a viewpoint"
 CLASS_KEYS = ["unseen", "seen_not_diffuse", "diffuse_no_specular", "fully_covered"]
-CLASS_COLOURS = [(128, 0, 128), (220, 40, 40), (240, 200, 0), (40, 180, 60)]  # coverage_class_color
+CLASS_COLOURS = [(128, 0, 128), (40, 90, 220), (240, 200, 0), (40, 180, 60)]  # coverage_class_color
 
 
 def run_server(wrapper, args, log_path, timeout=900):

@@ -78,10 +78,10 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
 
 TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   RichParameterList p = defaults_of(FitFilter());
-  p.setValue("lightFile", FileValue("a.lp"));
+  p.setValue("lightFile", StringValue("a.lp"));
   p.setValue("domeRadius", FloatValue(2.5f));
   p.setValue("lightUnitScale", FloatValue(10.0f));
-  p.setValue("outputPly", FileValue("out.ply"));
+  p.setValue("outputPly", StringValue("out.ply"));
   p.setValue("overwriteOutput", BoolValue(false));
   p.setValue("specularThreshold", FloatValue(0.8f));
   p.setValue("diffuseThreshold", FloatValue(0.3f));
@@ -94,6 +94,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("fitReflectance", BoolValue(false));
   p.setValue("fitBackend", EnumValue(1));
   p.setValue("initialShininess", FloatValue(20.0f));
+  p.setValue("specularLobe", EnumValue(0));
   p.setValue("maxIterations", IntValue(7));
   p.setValue("minSpecularSamples", IntValue(3));
   p.setValue("fillUnseenRings", IntValue(4));
@@ -111,6 +112,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, 0.3f);
   EXPECT_EQ(s.gather.encoding, vbrdf::PhotoEncoding::Linear);
   EXPECT_FLOAT_EQ(s.gather.saturation_level, 0.95f);
+  EXPECT_EQ(s.phong.lobe, vbrdf::LobeForm::PhongRE);
   EXPECT_EQ(s.gather.photo_cache_bytes, size_t(100) << 20);
   EXPECT_EQ(s.visibility_choice, vbrdf::VisibilityChoice::CPU);
   EXPECT_FLOAT_EQ(s.visibility.depth_tolerance, 0.01f);
@@ -142,6 +144,7 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
   rejects("memoryBudgetMB", IntValue(8));
   rejects("initialShininess", FloatValue(0.5f));
   rejects("maxIterations", IntValue(-1));
+  rejects("specularLobe", EnumValue(2));
   rejects("domeRadius", FloatValue(-1.0f));
   rejects("lightUnitScale", FloatValue(std::nanf("")));
   rejects("minSpecularSamples", IntValue(0));
@@ -183,8 +186,8 @@ TEST(CoverageSettingsFrom, TheImportRunsTheFiltersDefaults) {
 
 TEST(CoverageSettingsFrom, EveryParameterReachesItsField) {
   RichParameterList p = defaults_of(CoverageFilter());
-  p.setValue("lightFile", FileValue("b.lp"));
-  p.setValue("suggestionFile", FileValue("s.txt"));
+  p.setValue("lightFile", StringValue("b.lp"));
+  p.setValue("suggestionFile", StringValue("s.txt"));
   p.setValue("viewpointRaster", IntValue(3));
   p.setValue("specularThreshold", FloatValue(0.85f));
   p.setValue("diffuseThreshold", FloatValue(0.4f));
@@ -254,9 +257,9 @@ TEST(RelightSettingsFrom, DefaultsAndEveryParameter) {
   EXPECT_FLOAT_EQ(d.output.heat_map_max_de, vbrdf::RelightOutputOptions().heat_map_max_de);
 
   RichParameterList p = defaults;
-  p.setValue("fitResultPly", FileValue("fit.ply"));
-  p.setValue("rasterProject", FileValue("held.mlp"));
-  p.setValue("lightFile", FileValue("held.lp"));
+  p.setValue("fitResultPly", StringValue("fit.ply"));
+  p.setValue("rasterProject", StringValue("held.mlp"));
+  p.setValue("lightFile", StringValue("held.lp"));
   p.setValue("outputFolder", StringValue("out"));
   p.setValue("renderRasters", BoolValue(false));
   p.setValue("novelView", BoolValue(true));
@@ -326,7 +329,7 @@ TEST(SphereSettingsFrom, ManualOutlinesAndTheirChecks) {
   p.setValue("sphereCount", IntValue(2));
   p.setValue("sphereRadiusWorld", FloatValue(0.5f));
   p.setValue("photoEncoding", EnumValue(2));
-  p.setValue("outputLightFile", FileValue("s.lp"));
+  p.setValue("outputLightFile", StringValue("s.lp"));
   p.setValue("viewpointRaster", IntValue(4));
   const SphereFilter::Settings s = SphereFilter::settings_from(p);
   ASSERT_EQ(s.manual.size(), 2u);
@@ -368,11 +371,11 @@ TEST(ImportSettingsFrom, PhotoListSphereModeAndChecks) {
   p.setValue("photoFolder", StringValue(" photos "));
   p.setValue("referenceRaster", IntValue(1));
   p.setValue("lightSource", EnumValue(1));
-  p.setValue("lightFile", FileValue("old.lp"));
+  p.setValue("lightFile", StringValue("old.lp"));
   p.setValue("sphereCenterX", FloatValue(10.0f));
   p.setValue("sphereCenterY", FloatValue(11.0f));
   p.setValue("sphereRadius", FloatValue(12.0f));
-  p.setValue("outputLightFile", FileValue("new.lp"));
+  p.setValue("outputLightFile", StringValue("new.lp"));
   p.setValue("updateCoverage", BoolValue(false));
   const ImportPhotosFilter::Settings s = ImportPhotosFilter::settings_from(p);
   EXPECT_EQ(s.photo_files, (std::vector<std::string>{"a.png", "b.png", "c.png"}));
@@ -421,7 +424,7 @@ TEST(SharedParameters, EveryFilterDeclaresASharedNameIdentically) {
       shared::kMinSpecularSamples, shared::kViewpointRaster,  shared::kSphereCenterX,
       shared::kSphereCenterY,     shared::kSphereRadius,      shared::kOutputLightFile,
       shared::kColorCorrection,   shared::kChartCorners,      shared::kExposureNormalisation,
-      shared::kDomeRadius,        shared::kLightUnitScale};
+      shared::kDomeRadius,        shared::kLightUnitScale,   shared::kOnlySelected};
   // Their default (and the tooltip's last words) differ on purpose: filter_parameters.h says why.
   const std::set<std::string> deliberate = {shared::kDiffuseThreshold, shared::kOutputLightFile};
   for (const auto &kv : seen) {
@@ -452,6 +455,70 @@ TEST(SharedParameters, DefaultOutputLightFileSitsBesideTheProject) {
             "/data/scan/project_sphere.lp");
   EXPECT_EQ(shared::default_output_light_file("/data/scan/project.mlp", shared::OutputLightFileUse::Import),
             "/data/scan/project_lights.lp");
+}
+
+// --- Typed paths (issue 12) --------------------------------------------------------------------
+// MeshLab 2020.09's file widgets return only a path picked with "...": a typed path was lost. Every
+// path parameter is a string field now; the dialog's line edit (LineEditWidget::collectWidgetValue)
+// hands the typed text over as a StringValue, which is what these tests feed in.
+
+TEST(TypedPaths, NoFilterDeclaresAFileFieldThatDropsTypedText) {
+  const FitFilter fit;
+  const CoverageFilter coverage;
+  const RelightFilter relight;
+  const SphereFilter sphere;
+  const ImportPhotosFilter import;
+  size_t paths = 0;
+  for (const PluginFilter *f : std::vector<const PluginFilter *>{&fit, &coverage, &relight, &sphere, &import})
+    for (const RichParameter &p : defaults_of(*f)) {
+      EXPECT_FALSE(p.value().isFileName()) << utf8(f->name()) << ": '" << utf8(p.name())
+                                           << "' is a MeshLab file field, which ignores a typed path";
+      EXPECT_FALSE(p.toolTip().isEmpty()) << utf8(f->name()) << ": '" << utf8(p.name()) << "' has no tooltip";
+      if (p.toolTip().contains("Type or paste the path")) ++paths;
+    }
+  EXPECT_GE(paths, 8u);  // lightFile x3, outputPly, suggestionFile, outputLightFile x2, fitResultPly, rasterProject
+}
+
+TEST(TypedPaths, ATypedPathReachesEveryFiltersSettings) {
+  RichParameterList fit = defaults_of(FitFilter());
+  fit.setValue("lightFile", StringValue("  typed/lights.lp "));  // as typed, stray blanks included
+  fit.setValue("outputPly", StringValue("/tmp/typed out.ply"));
+  const vbrdf::FitSettings f = FitFilter::settings_from(fit);
+  EXPECT_EQ(f.light_file, "typed/lights.lp");
+  EXPECT_EQ(f.output_ply, "/tmp/typed out.ply");
+
+  RichParameterList coverage = defaults_of(CoverageFilter());
+  coverage.setValue("suggestionFile", StringValue("typed_next.txt"));
+  EXPECT_EQ(CoverageFilter::settings_from(coverage).suggestion_file, "typed_next.txt");
+
+  RichParameterList relight = defaults_of(RelightFilter());
+  relight.setValue("fitResultPly", StringValue("typed.ply"));
+  relight.setValue("rasterProject", StringValue("held/typed.mlp"));
+  const RelightFilter::Settings r = RelightFilter::settings_from(relight);
+  EXPECT_EQ(r.fit_result_ply, "typed.ply");
+  EXPECT_EQ(r.raster_project, "held/typed.mlp");
+}
+
+TEST(TypedPaths, AScriptWrittenWithFileFieldsStillWorks) {
+  // What meshlabserver builds from an older .mlx: the script's own parameter types, then the
+  // filter's defaults for whatever the script does not list.
+  QDomDocument doc;
+  doc.setContent(QString("<Param name='lightFile' type='RichOpenFile' value='old.lp' exts_cardinality='1' "
+                         "ext_val0='Light files (*.lp)' description='Light file' tooltip='t'/>"));
+  RichParameterList script;
+  script.pushFromQDomElement(doc.documentElement());
+  ASSERT_TRUE(script.getParameterByName("lightFile").value().isFileName());
+  for (const RichParameter &p : defaults_of(FitFilter()))
+    if (!script.hasParameter(p.name())) script.addParam(p);
+  EXPECT_EQ(FitFilter::settings_from(script).light_file, "old.lp");
+}
+
+TEST(TypedPaths, MessagesNameFieldsByTheirDialogLabels) {
+  const RichParameterList fit = defaults_of(FitFilter());
+  const std::string message = with_labels("Parameter 'maxIterations' must be in [0, 10000]; see 'lightFile'.", fit);
+  EXPECT_EQ(message, "Parameter 'Max iterations' [maxIterations] must be in [0, 10000]; see 'Light file (.lp, .json, "
+                     ".dome)' [lightFile].");
+  EXPECT_EQ(with_labels("nothing quoted", fit), "nothing quoted");
 }
 
 } // namespace

@@ -1,5 +1,6 @@
 #include "test_scenes.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vbrdf {
@@ -68,6 +69,20 @@ MeshData make_sphere(const float centre[3], float radius, int rings, int segment
       const uint32_t a = uint32_t(i * (segments + 1) + j), b = a + 1, c = a + uint32_t(segments + 1), d = c + 1;
       m.indices.insert(m.indices.end(), {a, b, c, b, d, c});
     }
+  return m;
+}
+
+MeshData make_bumpy_sphere(size_t target_vertices) {
+  const int rings = std::max(8, int(std::sqrt(double(target_vertices) / 2)));
+  const float c[3] = {0, 0, 0};
+  MeshData m = make_sphere(c, 1.0f, rings, 2 * rings);
+  for (size_t v = 0; v < m.positions.size() / 3; ++v) {
+    float *n = &m.normals[3 * v];
+    const float *p = &m.positions[3 * v];
+    n[0] += 0.3f * std::sin(17 * p[1]), n[1] += 0.3f * std::sin(13 * p[2]), n[2] += 0.3f * std::sin(11 * p[0]);
+    const float l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int k = 0; k < 3; ++k) n[k] /= l;
+  }
   return m;
 }
 

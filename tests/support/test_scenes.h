@@ -17,6 +17,10 @@ MeshData make_grid(int n, float half, float height);
 // A UV sphere (outward normals).
 MeshData make_sphere(const float centre[3], float radius, int rings, int segments);
 
+// A unit sphere of about `target_vertices` vertices whose normals carry a deterministic bump
+// pattern (a normal field that is not trivially smooth): the benchmarks' light-suggestion mesh.
+MeshData make_bumpy_sphere(size_t target_vertices);
+
 // Appends b to a (indices shifted).
 void append_mesh(MeshData &a, const MeshData &b);
 

@@ -4,7 +4,7 @@ set (make_psm_project.py) into a work folder, fits them with vbrdf_fit (defaults
 them with vbrdf_eval on the held-out lights.
 
     run_psm_real.py --data DIR --workdir DIR --fit-tool vbrdf_fit --eval-tool vbrdf_eval
-                    [--objects owl cat] [--photos linear|srgb]
+                    [--objects owl cat] [--photos linear|srgb] [--fit-options "--lobe re"]
 
 Checks (each can fail):
   * the set's decoding: on the matte grey sphere, grey ~ (N.L)^g with |g - 1| < 0.25 for the
@@ -133,7 +133,7 @@ def check_object(args, name):
     failures += ['%s: %s' % (name, f) for f in check_registration(out, mask)]
 
     fit_ply = os.path.join(out, 'fit.ply')
-    rc, text = run([args.fit_tool, os.path.join(out, 'project.mlp'), '--out', fit_ply])
+    rc, text = run([args.fit_tool, os.path.join(out, 'project.mlp'), '--out', fit_ply] + args.fit_options.split())
     if rc != 0 or not os.path.exists(fit_ply):
         print(text)
         return failures + ['%s: vbrdf_fit exited %d' % (name, rc)]
@@ -191,6 +191,7 @@ def main():
     ap.add_argument('--eval-tool', required=True)
     ap.add_argument('--objects', nargs='+', default=['owl', 'cat'])
     ap.add_argument('--photos', choices=('linear', 'srgb'), default='linear')
+    ap.add_argument('--fit-options', default='', help='extra vbrdf_fit options, e.g. "--lobe re"')
     args = ap.parse_args()
     if not os.path.isfile(os.path.join(args.data, 'lights.txt')):
         print('SKIP: real photometric-stereo set not found at %s (see the README: it lives in '

@@ -24,7 +24,8 @@ struct Scene {
 
 // A 31 x 31 grid whose normals fan out over +-40 degrees (a cap), 16 lights, camera along +z.
 // Vertices with x < 0 are glossy when `two_materials`, else every vertex is glossy.
-Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed) {
+// The true lobe is ks * cos^alpha with the cosine of `form` (R.E or N.H), as is Sample::lobe_cos.
+Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed, LobeForm form = LobeForm::PhongRE) {
   Scene sc;
   sc.mesh = test::make_grid(30, 1.0f, 0.0f);
   const size_t n = sc.mesh.positions.size() / 3;
@@ -51,12 +52,13 @@ Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed) {
     for (size_t l = 0; l < lights.size(); ++l) {
       const float *L = lights[l].data();
       const float d = N[0] * L[0] + N[1] * L[1] + N[2] * L[2];
-      const float s = 2 * d * N[2] - L[2];  // R.E with E = +z
+      const float E[3] = {0, 0, 1};
+      const float re = lobe_cosine(LobeForm::PhongRE, N, L, E), s = lobe_cosine(form, N, L, E);
       Sample smp{};
-      smp.n_dot_l = d, smp.r_dot_e = s, smp.raster = uint16_t(l);
+      smp.n_dot_l = d, smp.lobe_cos = s, smp.raster = uint16_t(l);
       const float g = glossy && s > 0 && d > 0 ? ks * std::pow(s, alpha) : 0.0f;
       for (int c = 0; c < 3; ++c) smp.rgb[c] = std::max(0.0f, (rho[c] * std::max(d, 0.0f) + g) * (1 + 0.01f * gauss(rng)));
-      smp.flags = uint16_t((d <= 0 ? kAttachedShadow : 0) | (d > 0 && d < 0.2f ? kGrazing : 0) | (s > 0.9f ? kHighlight : 0));
+      smp.flags = uint16_t((d <= 0 ? kAttachedShadow : 0) | (d > 0 && d < 0.2f ? kGrazing : 0) | (re > 0.9f ? kHighlight : 0));
       sc.chunk.samples.push_back(smp);
     }
     sc.chunk.offsets.push_back(uint32_t(sc.chunk.samples.size()));
@@ -69,8 +71,9 @@ struct StageRun {
   std::vector<VertexFit> before, after;
 };
 
-StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions()) {
+StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions(), LobeForm form = LobeForm::PhongRE) {
   PhongFitOptions o;
+  o.lobe = form;
   StageRun r;
   r.before.resize(sc.chunk.vertex_count);
   fit_chunk_cpu(sc.chunk, o, r.before.data());
@@ -83,12 +86,18 @@ StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions(
 
 } // namespace
 
-TEST(Materials, TwoMaterialsAndTheirLobesAreRecovered) {
-  const float ks = 0.5f, alpha = 30.0f;
-  const Scene sc = make_scene(true, ks, alpha, 7);
+
+class MaterialsBothLobes : public ::testing::TestWithParam<LobeForm> {};
+
+// Materials, their lobes (k_s, alpha in the form fitted) and every vertex's lobe weight (k_s, its
+// blend between the material's lobe and its own data) recovered, in either lobe form.
+TEST_P(MaterialsBothLobes, TwoMaterialsAndTheirLobesAreRecovered) {
+  const LobeForm form = GetParam();
+  const float ks = 0.5f, alpha = form == LobeForm::BlinnNH ? 120.0f : 30.0f;
+  const Scene sc = make_scene(true, ks, alpha, 7, form);
   MaterialOptions everywhere;
   everywhere.keep_full_fits = false;  // every glossy vertex takes the material-regularised lobe
-  const StageRun r = run_stage(sc, everywhere);
+  const StageRun r = run_stage(sc, everywhere, form);
   ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
   ASSERT_EQ(r.result.materials.size(), 2u);
   // Which found material is the glossy one: the one holding most truly glossy vertices.
@@ -130,6 +139,11 @@ TEST(Materials, TwoMaterialsAndTheirLobesAreRecovered) {
       << "per-vertex alpha median error " << per_vertex_median << ", glossy vertices with k_s > 0 before: "
       << glossy_ks_before << " of " << glossy_n;
 }
+
+INSTANTIATE_TEST_SUITE_P(LobeForms, MaterialsBothLobes, ::testing::Values(LobeForm::PhongRE, LobeForm::BlinnNH),
+                         [](const ::testing::TestParamInfo<LobeForm> &i) {
+                           return std::string(i.param == LobeForm::BlinnNH ? "NH" : "RE");
+                         });
 
 TEST(Materials, OneGlossyMaterialIsOneMaterial) {
   const Scene sc = make_scene(false, 0.4f, 60.0f, 11);

@@ -63,10 +63,10 @@ void usable_counts(const SampleChunk &chunk, uint32_t v, const PhongFitOptions &
     const Sample &s = chunk.samples[i];
     if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0) || !std::isfinite(s.n_dot_l)) continue;
     if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) ||
-        !std::isfinite(s.r_dot_e))
+        !std::isfinite(s.lobe_cos))
       continue;
     ++n;
-    n_high += s.r_dot_e > o.specular_threshold;
+    n_high += s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold);
   }
 }
 
@@ -201,12 +201,12 @@ std::vector<Sample> degenerate_vertex(Kind kind, std::mt19937 &rng) {
   case kAllEqual: for (auto &x : s) x = s[0]; break;
   case kSingle: s.resize(1); break;
   case kAllGrazing: for (auto &x : s) x.n_dot_l = 1e-4f * u(rng), x.flags |= kGrazing; break;
-  case kSToZero: for (auto &x : s) x.r_dot_e = 1e-30f * u(rng); break;
-  case kSToOne: for (auto &x : s) x.r_dot_e = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
-  case kDuplicateLights: for (auto &x : s) x.n_dot_l = s[0].n_dot_l, x.r_dot_e = s[0].r_dot_e; break;
+  case kSToZero: for (auto &x : s) x.lobe_cos = 1e-30f * u(rng); break;
+  case kSToOne: for (auto &x : s) x.lobe_cos = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
+  case kDuplicateLights: for (auto &x : s) x.n_dot_l = s[0].n_dot_l, x.lobe_cos = s[0].lobe_cos; break;
   case kZeroPixels: for (auto &x : s) x.rgb[0] = x.rgb[1] = x.rgb[2] = 0; break;
   case kSaturatedOnly: for (auto &x : s) x.flags |= kSaturated; break;
-  case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().r_dot_e = std::nanf(""); break;
+  case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().lobe_cos = std::nanf(""); break;
   case kHugeValues: for (auto &x : s) x.rgb[0] *= 1e6f; break;
   case kTinyValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e-30f; break;
   case kExtremeValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e30f; break;  // squares overflow float
@@ -313,6 +313,34 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuUnderOtherOptions) {
     EXPECT_GT(a.well, 300) << c.label;
     EXPECT_LE(a.well_disagree, a.well / 200) << c.label;  // step decisions at float resolution
   }
+}
+
+// The half-angle (N.H) lobe: its thresholds and SQ term, and samples weighted by their photo's
+// resolution (Sample::resolution codes 0-31, as several cameras give), in both back ends alike.
+TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<int> code(0, 31);
+  SampleChunk chunk;
+  for (int v = 0; v < 4000; ++v) {
+    std::vector<Sample> s = random_vertex(rng);
+    for (Sample &x : s) x.resolution = uint16_t(v % 2 ? code(rng) : 0);
+    append_vertex(chunk, s);
+  }
+  PhongFitOptions half_angle;
+  half_angle.lobe = LobeForm::BlinnNH;
+  PhongFitOptions mirror;  // R.E with resolution weights only
+  for (const PhongFitOptions *o : {&half_angle, &mirror}) {
+    const Agreement a = agree(chunk, *o, o->lobe == LobeForm::BlinnNH ? "N.H lobe, resolution weights" : "R.E lobe, resolution weights");
+    EXPECT_GT(a.well, 1000);
+    EXPECT_LE(a.well_disagree, a.well / 200);
+  }
+  // The weights matter: the same samples without them give other fits.
+  SampleChunk plain = chunk;
+  for (Sample &x : plain.samples) x.resolution = 0;
+  const std::vector<VertexFit> weighted = run_cpu(chunk, mirror), unweighted = run_cpu(plain, mirror);
+  int differ = 0;
+  for (uint32_t v = 1; v < chunk.vertex_count; v += 2) differ += parameter_difference(weighted[v], unweighted[v]) > 1e-3;
+  EXPECT_GT(differ, int(chunk.vertex_count) / 8);
 }
 
 TEST_F(PhongFitGpuTest, TwoHundredFiftySixPhotoVertices) {

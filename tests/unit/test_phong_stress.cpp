@@ -23,12 +23,12 @@ std::vector<Sample> make_vertex(Kind kind, std::mt19937 &rng) {
   case kAllEqual: for (auto &x : s) x = s[0]; break;
   case kSingle: s.resize(1); break;
   case kAllGrazing: for (auto &x : s) x.n_dot_l = 1e-4f * u(rng), x.flags |= kGrazing; break;
-  case kSToZero: for (auto &x : s) x.r_dot_e = 1e-30f * u(rng); break;
-  case kSToOne: for (auto &x : s) x.r_dot_e = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
-  case kDuplicateLights: for (auto &x : s) x.n_dot_l = s[0].n_dot_l, x.r_dot_e = s[0].r_dot_e; break;
+  case kSToZero: for (auto &x : s) x.lobe_cos = 1e-30f * u(rng); break;
+  case kSToOne: for (auto &x : s) x.lobe_cos = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
+  case kDuplicateLights: for (auto &x : s) x.n_dot_l = s[0].n_dot_l, x.lobe_cos = s[0].lobe_cos; break;
   case kZeroPixels: for (auto &x : s) x.rgb[0] = x.rgb[1] = x.rgb[2] = 0; break;
   case kSaturatedOnly: for (auto &x : s) x.flags |= kSaturated; break;
-  case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().r_dot_e = std::nanf(""); break;
+  case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().lobe_cos = std::nanf(""); break;
   case kHugeValues: for (auto &x : s) x.rgb[0] *= 1e6f; break;
   default: break;
   }

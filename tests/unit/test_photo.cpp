@@ -2,8 +2,13 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <fstream>
+#include <thread>
+#include <vector>
+
 #include "base/errors.h"
 #include "inputs/photo.h"
+#include "inputs/photo_prefetch.h"
 #include "test_paths.h"
 
 using namespace vbrdf;
@@ -89,6 +94,66 @@ TEST(PhotoCache, StaysUnderBudgetAndReloads) {
   cache.get(b);
   cache.get(a);
   EXPECT_EQ(cache.loads(), 3u);
+}
+
+// Several threads asking for one photo decode it once, and every one gets it.
+TEST(PhotoCache, DecodesAPhotoOnceForConcurrentRequests) {
+  cv::Mat img(300, 400, CV_8UC3, cv::Scalar(10, 20, 30));
+  const std::string a = write_png(img, "concurrent.png");
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, size_t(64) << 20);
+  std::vector<std::shared_ptr<const Photo>> got(6);
+  std::vector<std::thread> threads;
+  for (size_t i = 0; i < got.size(); ++i) threads.emplace_back([&, i] { got[i] = cache.get(a, 400, 300); });
+  for (std::thread &t : threads) t.join();
+  EXPECT_EQ(cache.loads(), 1u);
+  for (const auto &p : got) EXPECT_EQ(p.get(), got[0].get());
+}
+
+// The prefetch decodes every photo of a project once, in the background: the gathering's later
+// requests find them (no second decode). A photo that cannot be decoded is reported by finish(),
+// naming it, after the good ones were decoded.
+TEST(PhotoPrefetch, DecodesEachPhotoOnceAndReportsTheBadOne) {
+  cv::Mat img(60, 80, CV_8UC3, cv::Scalar(1, 2, 3));
+  std::vector<Raster> rasters(5);
+  for (size_t i = 0; i < rasters.size(); ++i) {
+    rasters[i].image_path = write_png(img, "prefetch" + std::to_string(i) + ".png");
+    rasters[i].shot.Intrinsics.ViewportPx = vcg::Point2i(80, 60);
+  }
+  {
+    PhotoCache cache(PhotoEncoding::Auto, 0.99f, size_t(64) << 20);
+    auto prefetch = start_photo_prefetch(cache, rasters);
+    prefetch->finish();
+    EXPECT_EQ(cache.loads(), rasters.size());
+    for (const Raster &r : rasters) cache.get(r.image_path, 80, 60);
+    EXPECT_EQ(cache.loads(), rasters.size());
+  }
+  const std::string broken = test::scratch_dir("photo") + "/prefetch_broken.png";
+  std::ofstream(broken) << "not a png";
+  rasters[3].image_path = broken;
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, size_t(64) << 20);
+  auto prefetch = start_photo_prefetch(cache, rasters);
+  try {
+    prefetch->finish();
+    ADD_FAILURE() << "the broken photo was not reported";
+  } catch (const InputError &e) {
+    EXPECT_NE(std::string(e.what()).find("prefetch_broken.png"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(cache.loads(), rasters.size() - 1);
+}
+
+// Prefetching never decodes more than the cache's budget holds (a photo decoded and evicted before
+// use would be decoded twice); the rest decode on demand.
+TEST(PhotoPrefetch, StopsAtTheCacheBudget) {
+  cv::Mat img(100, 100, CV_8UC3, cv::Scalar(1, 2, 3));  // 30 kB decoded (+ LUT)
+  std::vector<Raster> rasters(8);
+  for (size_t i = 0; i < rasters.size(); ++i) {
+    rasters[i].image_path = write_png(img, "budget" + std::to_string(i) + ".png");
+    rasters[i].shot.Intrinsics.ViewportPx = vcg::Point2i(100, 100);
+  }
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, 100000);  // room for three
+  start_photo_prefetch(cache, rasters)->finish();
+  EXPECT_GE(cache.loads(), 1u);
+  EXPECT_LE(cache.loads(), 3u);
 }
 
 namespace vbrdf {

@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <cmath>
+#include <cstring>
+
 #include "samples/samples.h"
 #include "test_paths.h"
 #include "test_scenes.h"
@@ -43,7 +46,7 @@ TEST(Samples, HeadOnLightIsHighlightAndColourIsDecoded) {
   const Sample s = f.sample(kOrigin, kFacing, kFacing);
   EXPECT_EQ(s.raster, 3);
   EXPECT_NEAR(s.n_dot_l, 1, 1e-6);
-  EXPECT_NEAR(s.r_dot_e, 1, 1e-6);
+  EXPECT_NEAR(s.lobe_cos, 1, 1e-6);
   EXPECT_EQ(s.flags, kHighlight);
   EXPECT_NEAR(s.rgb[0], srgb_to_linear(200 / 255.0f), 1e-5);  // BGR on disk
   EXPECT_TRUE(is_specular_sample(s));
@@ -56,7 +59,7 @@ TEST(Samples, DiffuseGrazingAndShadowFlags) {
   Sample s = f.sample(kOrigin, kFacing, side60);
   EXPECT_EQ(s.flags, 0) << s.flags;
   EXPECT_NEAR(s.n_dot_l, 0.5, 1e-6);
-  EXPECT_NEAR(s.r_dot_e, 0.5, 1e-2);  // R = (-0.866, 0, 0.5), E ~ (0, 0, 1)
+  EXPECT_NEAR(s.lobe_cos, 0.5, 1e-2);  // R = (-0.866, 0, 0.5), E ~ (0, 0, 1)
   EXPECT_TRUE(is_diffuse_sample(s));
   const float graze[3] = {0.97f, 0, 0.2431f};
   EXPECT_EQ(f.sample(kOrigin, kFacing, graze).flags, kGrazing);
@@ -181,3 +184,100 @@ TEST(Samples, CleanSamplesArePreferredOverRimOnes) {
 }
 } // namespace
 } // namespace vbrdf
+
+TEST(Samples, HalfAngleLobeCosine) {
+  Fixture f;
+  f.settings.lobe = LobeForm::BlinnNH;
+  // L at 60 degrees from N in the x-z plane, E ~ (0, 0, 1): R.E = 0.5, the N-H angle is half the
+  // R-E angle (30 degrees): N.H = cos 30 = sqrt((1 + 0.5)/2). kHighlight stays on R.E.
+  const LightSource side60 = LightSource::directional({{0.8660254f, 0, 0.5f}});
+  const Sample s = f.sample(kOrigin, kFacing, side60);
+  EXPECT_NEAR(s.lobe_cos, std::cos(30 * 3.14159265 / 180), 2e-3);
+  EXPECT_NEAR(s.lobe_cos, lobe_threshold(LobeForm::BlinnNH, 0.5f), 2e-3);
+  EXPECT_EQ(s.flags, 0);
+  EXPECT_NEAR(f.sample(kOrigin, kFacing, kFacing).lobe_cos, 1, 1e-6);
+  EXPECT_EQ(f.sample(kOrigin, kFacing, kFacing).flags, kHighlight);
+  // Out of the plane of incidence the two cosines are not tied: N tilted about x, L about y.
+  const float n[3] = {0, 0.3f, 0.9539392f}, l[3] = {0.5f, 0, 0.8660254f}, e[3] = {0, 0, 1};
+  const float nh = lobe_cosine(LobeForm::BlinnNH, n, l, e), re = lobe_cosine(LobeForm::PhongRE, n, l, e);
+  float h[3] = {l[0] + e[0], l[1] + e[1], l[2] + e[2]};
+  const float hl = std::sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+  EXPECT_NEAR(nh, (n[0] * h[0] + n[1] * h[1] + n[2] * h[2]) / hl, 1e-6);
+  const float nl = n[0] * l[0] + n[1] * l[1] + n[2] * l[2], ne = n[2];
+  EXPECT_NEAR(re, 2 * nl * ne - l[2], 1e-6);
+  EXPECT_EQ(lobe_cosine(LobeForm::BlinnNH, kFacing, kFacing, kFacing), 1.0f);
+  const float opposite[3] = {0, 0, -1};
+  EXPECT_EQ(lobe_cosine(LobeForm::BlinnNH, kFacing, opposite, kFacing), 0.0f);  // H undefined
+  LobeForm parsed;
+  EXPECT_TRUE(parse_lobe_form("nh", parsed) && parsed == LobeForm::BlinnNH);
+  EXPECT_TRUE(parse_lobe_form(lobe_form_name(LobeForm::PhongRE), parsed) && parsed == LobeForm::PhongRE);
+  EXPECT_FALSE(parse_lobe_form("ggx", parsed));
+}
+
+TEST(Samples, ResolutionWeightFollowsDistanceAndObliquity) {
+  Fixture f;
+  const float n[3] = {0, 0, 1};
+  const float near_res = photo_resolution(f.raster, kOrigin, n);
+  Raster far = f.raster, oblique = f.raster;
+  const float c_far[3] = {0, 0, 20}, c_obl[3] = {0, 8.660254f, 5}, t[3] = {0, 0, 0}, up[3] = {0, 1, 0}, up2[3] = {0, 0, 1};
+  far.shot = test::make_look_at_shot(c_far, t, up, 500, 64, 48);
+  oblique.shot = test::make_look_at_shot(c_obl, t, up2, 500, 64, 48);
+  EXPECT_NEAR(photo_resolution(far, kOrigin, n) / near_res, 0.25, 1e-4);      // twice as far
+  EXPECT_NEAR(photo_resolution(oblique, kOrigin, n) / near_res, 0.5, 1e-3);  // N.E = 0.5, same distance
+  const float back[3] = {0, 0, -1};
+  EXPECT_EQ(photo_resolution(f.raster, kOrigin, back), 0.0f);
+  EXPECT_EQ(resolution_code(1.0f), 0);
+  EXPECT_EQ(resolution_code(0.5f), 8);
+  EXPECT_EQ(resolution_code(0.0f), 63);
+  EXPECT_EQ(resolution_code(1e-6f), 63);
+  Sample s{};
+  s.resolution = 8;
+  EXPECT_FLOAT_EQ(resolution_weight(s), 0.5f);
+}
+
+TEST(Samples, GatherCodesEachSamplesResolutionAgainstTheVertexsBestPhoto) {
+  Fixture f;
+  MeshData mesh;
+  for (int i = 0; i < 100; ++i) {
+    mesh.positions.insert(mesh.positions.end(), {-0.2f + (i % 10) / 25.0f, -0.2f + (i / 10) / 25.0f, 0});
+    mesh.normals.insert(mesh.normals.end(), {0, 0, 1});
+  }
+  mesh.indices = {0, 1, 10};
+  Raster far = f.raster;
+  const float c_far[3] = {0, 0, 20}, t[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+  far.shot = test::make_look_at_shot(c_far, t, up, 500, 64, 48);
+  const std::vector<Raster> rasters = {f.raster, far, f.raster};
+  const std::vector<std::array<float, 3>> lights = {{{0, 0, 1}}, {{0, 0, 1}}, {{0.5f, 0, 0.8660254f}}};
+  VisibilityMasks masks;
+  masks.vertex_count = 100;
+  masks.raster_count = 3;
+  masks.seen.assign(masks.words() * 3, ~uint64_t(0));
+  masks.lit.assign(masks.words() * 3, ~uint64_t(0));
+  masks.mixed.assign(masks.words() * 3, 0);
+  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded}) v->assign(3, 0);
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
+  for (bool weights : {true, false}) {
+    GatherSettings settings;
+    settings.resolution_weights = weights;
+    int checked = 0;
+    gather_samples(mesh.view(), rasters, directional_lights(lights), masks, settings, cache, [&](const SampleChunk &c) {
+      for (uint32_t k = 0; k < c.samples.size(); ++k, ++checked) {
+        const Sample &s = c.samples[k];
+        if (!weights || s.raster != 1) EXPECT_EQ(s.resolution, 0) << "raster " << s.raster;
+        else EXPECT_NEAR(s.resolution, 16, 1) << "twice as far: a quarter of the pixels";
+      }
+    });
+    EXPECT_EQ(checked, 300);
+  }
+}
+
+// shaders/phong_fit.comp reads a sample's last word as raster | flags << 16 | resolution << 26.
+TEST(Samples, SampleWordMatchesTheShader) {
+  Sample s{};
+  s.raster = 0x1234;
+  s.flags = kHighlight | kMixedPixel | kRimFootprint;
+  s.resolution = 0x2A;
+  uint32_t word = 0;
+  std::memcpy(&word, reinterpret_cast<const char *>(&s) + 20, 4);
+  EXPECT_EQ(word, 0x1234u | uint32_t(kHighlight | kMixedPixel | kRimFootprint) << 16 | 0x2Au << 26);
+}

@@ -1108,5 +1108,79 @@ TEST_F(GlVisibilityTest, BorderVerticesHaveMixedFootprints) {
     EXPECT_EQ(interior_clean, interior) << b->name();
   }
 }
+
+// The depth tests run in a compute shader where the context has one (the map stays on the GPU),
+// else on the CPU after reading the map back: both paths must give the same code for every vertex
+// (camera footprints, directional and point-light shadows), on a mesh with real occlusion, mesh
+// borders and shadows. A float rounding of a window coordinate may put a vertex into the next
+// texel in one path: at most 0.1 % of the vertices may differ.
+TEST_F(GlVisibilityTest, ComputeShaderTestsGiveTheReadBackCodes) {
+  const GlApi api = load_gl_api(context_->get_proc_address());
+  if (!api.has_compute) GTEST_SKIP() << "no compute shaders in this context: only the read-back path runs";
+  const MeshData m = dense_scene(160, 24);
+  VisibilitySettings on, off;
+  off.depth_tests_on_gpu = false;
+  auto gpu = gl(m, on), readback = gl(m, off);
+  EXPECT_NE(std::string(gpu->name()).find("compute shader"), std::string::npos) << gpu->name();
+  EXPECT_NE(std::string(readback->name()).find("read back"), std::string::npos) << readback->name();
+  const auto differing = [&](const std::vector<uint8_t> &a, const std::vector<uint8_t> &b) {
+    size_t d = 0;
+    for (size_t v = 0; v < a.size(); ++v) d += a[v] != b[v];
+    return d;
+  };
+  const size_t limit = vertex_count(m) / 1000;
+  for (const Shot &shot : {dense_scene_camera(), dense_scene_camera(321, 237)}) {
+    const auto a = run_camera(*gpu, m, shot), b = run_camera(*readback, m, shot);
+    std::printf("  camera %dx%d: %zu of %u vertices differ; %ld hidden, %ld partial footprints\n",
+                shot.Intrinsics.ViewportPx[0], shot.Intrinsics.ViewportPx[1], differing(a, b), vertex_count(m),
+                long(std::count(a.begin(), a.end(), kCameraHidden)),
+                long(std::count_if(a.begin(), a.end(), [](uint8_t c) { return (c & kFootprintPartial) != 0; })));
+    EXPECT_LE(differing(a, b), limit);
+    EXPECT_GT(std::count(a.begin(), a.end(), kCameraHidden), long(vertex_count(m) / 50));  // the test has teeth
+  }
+  for (V3 light : kLights) {
+    const auto a = run_light(*gpu, m, normalized(light)), b = run_light(*readback, m, normalized(light));
+    EXPECT_LE(differing(a, b), limit) << light_label("dense", normalized(light));
+    EXPECT_GT(std::count(a.begin(), a.end(), 0), 10);
+  }
+  for (V3 position : {V3{0.2, -0.3, 2.2}, V3{-2.4, 0.4, 0.9}}) {
+    const auto a = run_point_light(*gpu, m, position), b = run_point_light(*readback, m, position);
+    EXPECT_LE(differing(a, b), limit);
+    EXPECT_GT(std::count(a.begin(), a.end(), 0), 10);
+  }
+}
+
+// The compute path binds shader-storage buffers and texture unit 0: the host's bindings there
+// come back as they were.
+TEST_F(GlVisibilityTest, ComputeShaderTestsRestoreTheHostsBindings) {
+  const GlApi api = load_gl_api(context_->get_proc_address());
+  if (!api.has_compute) GTEST_SKIP() << "no compute shaders in this context";
+  const MeshData m = box_scene();
+  auto g = gl(m);
+  GLuint host_buffers[2] = {0, 0}, host_texture = 0;
+  api.GenBuffers(2, host_buffers);
+  api.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, host_buffers[0]);
+  api.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, host_buffers[1]);
+  api.GenTextures(1, &host_texture);
+  api.ActiveTexture(GL_TEXTURE0);
+  api.BindTexture(GL_TEXTURE_2D, host_texture);
+  api.ActiveTexture(GL_TEXTURE3);
+  run_camera(*g, m, box_scene_camera());
+  run_light(*g, m, {0, 0, 1});
+  GLint unit = 0, texture = -1, b0 = -1, b1 = -1;
+  api.GetIntegerv(GL_ACTIVE_TEXTURE, &unit);
+  EXPECT_EQ(unit, GL_TEXTURE3);
+  api.ActiveTexture(GL_TEXTURE0);
+  api.GetIntegerv(GL_TEXTURE_BINDING_2D, &texture);
+  EXPECT_EQ(GLuint(texture), host_texture);
+  api.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, 0, &b0);
+  api.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, 1, &b1);
+  EXPECT_EQ(GLuint(b0), host_buffers[0]);
+  EXPECT_EQ(GLuint(b1), host_buffers[1]);
+  EXPECT_EQ(api.GetError(), GLenum(GL_NO_ERROR));
+  g.reset();
+  api.DeleteTextures(1, &host_texture);
+  api.DeleteBuffers(2, host_buffers);
+}
 } // namespace
 } // namespace vbrdf

@@ -61,6 +61,12 @@ constexpr double kOuterOutlineMinScore = 0.6;  // the outer outline wins unless 
 constexpr double kNestedOuterMinScore = 0.3;
 constexpr double kNestedSlackPx = 1;      // "inside" allows this much overlap
 constexpr double kFinalRefineShiftPx = 2.0;  // refine_sphere's search range for the final outline
+// check_sphere_circle: a given circle is the sphere's when the strongest outline near it (within
+// the refinement's reach) is at most max(this many pixels, this fraction of the radius) away.
+// Detected and published outlines of the same sphere differ by up to 0.7 % of the radius
+// (tests/calib/RESULTS.md); a circle with y counted from the wrong edge is off by far more.
+constexpr double kCircleCheckMinOffsetPx = 3.0;
+constexpr double kCircleCheckOffsetRadii = 0.03;
 
 
 std::string fmt(const char *format, double a = 0, double b = 0, double c = 0, double d = 0) {
@@ -1238,6 +1244,99 @@ std::vector<LightEntry> light_entries(const LightCalibration &cal, const std::ve
     out.push_back(e);
   }
   return out;
+}
+
+CircleCheck check_sphere_circle(size_t count, const GrayLoader &load, const SphereCamera &cam,
+                                const SphereCircle &circle, const SphereSearch &search) {
+  CircleCheck out;
+  out.refined = circle;
+  const PhotoSummary summary = summarize_photos(count, load, search);
+  if (summary.max_img.empty() || !(circle.r > 0)) {
+    out.description = "no photo or no circle to check";
+    return out;
+  }
+  cv::Mat full_max, full_med;
+  full_resolution_images(summary, count, load, full_max, full_med);
+  const EdgeImage edges_max = make_edge_image(full_max, kEdgeExponent, kEdgeSigmaPx);
+  const EdgeImage edges_med = make_edge_image(full_med, kEdgeExponent, kEdgeSigmaPx);
+  const SphereModel given = sphere_from_circle(cam, circle);
+  const double s_max = edge_score(edges_max, cam, given), s_med = edge_score(edges_med, cam, given);
+  out.outline_score = std::max(s_max, s_med);
+  out.outline_coverage = edge_coverage(s_max >= s_med ? edges_max : edges_med, cam, given);
+  out.spots_inside = size_t(spot_support(summary.spots, circle, out.photos_with_spot));
+  const size_t needed = std::max<size_t>(kMinSupportPhotos, (out.photos_with_spot * kMinSupportTenths + 9) / 10);
+  out.plausible = out.outline_coverage >= kMinOutlineCoverage &&
+                  (out.photos_with_spot >= kMinPhotosWithSpots ? out.spots_inside >= needed
+                                                               : out.outline_score >= search.min_edge_score);
+  const double shift = std::max(kRefineShiftMinPx, kRefineShiftRadii * circle.r);
+  out.refined = refine_on(s_max >= s_med ? edges_max : edges_med, cam, given, shift, nullptr).circle;
+  out.offset_px = std::max(std::hypot(out.refined.x - circle.x, out.refined.y - circle.y),
+                           std::fabs(out.refined.r - circle.r));
+  const bool on_outline = out.offset_px <= std::max(kCircleCheckMinOffsetPx, kCircleCheckOffsetRadii * circle.r);
+  out.description = fmt("circle (%.1f, %.1f) r %.1f px: outline visible on %.0f %% of its length", circle.x, circle.y,
+                        circle.r, 100.0 * out.outline_coverage) +
+                    ", bright spot inside in " + std::to_string(out.spots_inside) + " of " +
+                    std::to_string(out.photos_with_spot) + " photos with one" +
+                    fmt(", strongest outline nearby at (%.1f, %.1f) r %.1f px", out.refined.x, out.refined.y,
+                        out.refined.r) + fmt(" (%.1f px away)", out.offset_px);
+  out.plausible = out.plausible && on_outline;
+  out.description += out.plausible ? ": a sphere" : ": NOT this sphere's outline in these photos";
+  return out;
+}
+
+std::vector<HighlightBlob> highlight_blobs(const cv::Mat &gray, const SphereCircle &c, const HighlightSettings &s) {
+  std::vector<HighlightBlob> blobs;
+  if (gray.empty() || !(c.r > 0)) return blobs;
+  const double r_in = c.r * (1.0 - s.rim_margin);
+  const cv::Rect box = cv::Rect(int(std::floor(c.x - r_in)), int(std::floor(c.y - r_in)), int(2 * r_in) + 2,
+                                int(2 * r_in) + 2) & cv::Rect(0, 0, gray.cols, gray.rows);
+  if (box.width < 3 || box.height < 3) return blobs;
+  cv::Mat img, mask = cv::Mat::zeros(box.size(), CV_8U);
+  cv::GaussianBlur(gray(box), img, cv::Size(0, 0), 1.0);
+  cv::circle(mask, cv::Point2d(c.x - box.x - 0.5, c.y - box.y - 0.5), int(r_in), cv::Scalar(255), cv::FILLED);
+  double peak = 0;
+  cv::minMaxLoc(img, nullptr, &peak, nullptr, nullptr, mask);
+  const double background = masked_median(img, mask);
+  if (peak < s.min_peak || peak - background < s.min_contrast) return blobs;
+  const cv::Mat bright = (img > background + 0.5 * (peak - background)) & mask;
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(bright, labels, stats, centroids, 8, CV_32S);
+  std::vector<HighlightBlob> all(size_t(std::max(0, n - 1)));
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x) {
+      const int l = labels.at<int>(y, x);
+      if (l > 0) all[size_t(l - 1)].peak = std::max(all[size_t(l - 1)].peak, double(img.at<float>(y, x)));
+    }
+  int largest = 0;
+  for (int i = 1; i < n; ++i) {
+    HighlightBlob &b = all[size_t(i - 1)];
+    b.area = stats.at<int>(i, cv::CC_STAT_AREA);
+    b.x = centroids.at<double>(i, 0) + box.x + 0.5;
+    b.y = centroids.at<double>(i, 1) + box.y + 0.5;
+    largest = std::max(largest, b.area);
+  }
+  const double min_area = std::max({1.0, 0.25 * s.min_area_px, 0.05 * largest});
+  for (const HighlightBlob &b : all)
+    if (b.peak >= 0.8 * peak && b.area >= min_area) blobs.push_back(b);
+  return blobs;
+}
+
+std::vector<int> moving_highlight_counts(const std::vector<std::vector<HighlightBlob>> &blobs, double radius) {
+  const double near = 0.1 * radius;
+  const size_t needed = std::max<size_t>(3, (blobs.size() + 1) / 2);
+  std::vector<int> counts(blobs.size(), 0);
+  for (size_t i = 0; i < blobs.size(); ++i)
+    for (const HighlightBlob &b : blobs[i]) {
+      size_t photos_with_it = 0;
+      for (const std::vector<HighlightBlob> &other : blobs)
+        for (const HighlightBlob &o : other)
+          if (std::hypot(o.x - b.x, o.y - b.y) <= near) {
+            ++photos_with_it;
+            break;
+          }
+      counts[i] += photos_with_it < needed;  // counts the photo itself: a static blob is in most
+    }
+  return counts;
 }
 
 } // namespace vbrdf

@@ -160,6 +160,42 @@ using GrayLoader = std::function<cv::Mat(size_t index)>;
 std::vector<DetectedSphere> detect_spheres(size_t photo_count, const GrayLoader &load, const SphereCamera &cam,
                                            const SphereSearch &search, std::vector<std::string> &log);
 
+// Whether a given outline (a user's circle) is a sphere in these photos, by the rules detection
+// applies to its candidates: the outline shows on at least half its length, and the circle holds a
+// bright spot in 70 % of the photos that have one (or, with fewer than 3 such photos, the outline
+// scores search.min_edge_score), and the strongest outline near it (within 15 % of the radius)
+// lies within max(3 px, 3 % of the radius) of it. A circle in another pixel convention (y from the
+// bottom) or of another photo fails.
+struct CircleCheck {
+  bool plausible = false;
+  double outline_coverage = 0;  // fraction of the outline where an edge shows
+  double outline_score = 0;     // outline contrast (as DetectedSphere::edge_score)
+  size_t photos_with_spot = 0;  // photos holding a bright spot anywhere
+  size_t spots_inside = 0;      // ... inside the circle
+  SphereCircle refined;         // the strongest outline near the circle
+  double offset_px = 0;         // how far it is from the given circle (centre or radius)
+  std::string description;      // one line for the user: the figures and the verdict
+};
+CircleCheck check_sphere_circle(size_t photo_count, const GrayLoader &load, const SphereCamera &cam,
+                                const SphereCircle &circle, const SphereSearch &search = {});
+
+// Bright blobs on a sphere in one photo: inside `circle` (shrunk by the rim margin), above half-way
+// between the sphere's median and its brightest point, each at least 0.8 times as bright as the
+// brightest and at least 5 % of the largest one's area (fragments of one highlight are not blobs).
+struct HighlightBlob {
+  double x = 0, y = 0;  // centroid (image pixels)
+  int area = 0;         // pixels
+  double peak = 0;      // brightest smoothed value
+};
+std::vector<HighlightBlob> highlight_blobs(const cv::Mat &gray, const SphereCircle &circle,
+                                           const HighlightSettings &settings = {});
+
+// Per photo, how many of its blobs move with the light: blobs found at the same place (within 10 %
+// of `radius`) in at least half of the photos (and 3) are reflections of something that stays
+// lit whatever the light (a lamp, a window, the camera) and do not count. One light: 1; a photo
+// with a second lamp on or lit by the room: 2 or more; no highlight: 0.
+std::vector<int> moving_highlight_counts(const std::vector<std::vector<HighlightBlob>> &blobs, double radius);
+
 // Refines a sphere in a linear grey image within +-max_shift pixels: the centre to the strongest
 // outline of the square-root image (its edge shift is the same all around, so it does not move
 // the centre), then the radius to where the intensity crosses half-way between inside and

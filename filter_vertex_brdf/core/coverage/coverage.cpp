@@ -225,7 +225,7 @@ const char *coverage_class_name(CoverageClass c) {
 std::array<uint8_t, 4> coverage_class_color(CoverageClass c) {
   switch (c) {
   case kUnseen: return {{128, 0, 128, 255}};         // purple
-  case kSeenNotDiffuse: return {{220, 40, 40, 255}}; // red
+  case kSeenNotDiffuse: return {{40, 90, 220, 255}}; // blue (MeshLab draws its selection in red)
   case kDiffuseNoSpecular: return {{240, 200, 0, 255}}; // yellow
   default: return {{40, 180, 60, 255}};               // green
   }

@@ -16,6 +16,7 @@
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "inputs/light_file.h"
+#include "inputs/photo_prefetch.h"
 #include "io/coverage_outputs.h"
 #include "base/vec3.h"
 #include "coverage/coverage_geometry.h"
@@ -238,12 +239,13 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
       (unused.empty() ? std::string(".") : " (" + std::to_string(unused.size()) + " entries for photos not imported yet)."));
 
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
-  for (const Raster &raster : input.rasters) photos.get(raster.image_path, raster.width(), raster.height());
+  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);  // as the fit
 
   auto t = Clock::now();
   const VisibilityMasks masks = compute_visibility(mesh, input.rasters, sources, visibility,
                                                    [&](float f, const char *s) { return !progress || progress(0.45f * f, s); });
   r.seconds_visibility = seconds_since(t);
+  prefetch->finish();
 
   t = Clock::now();
   r.counts.assign(n, CoverageCounts());
@@ -256,20 +258,30 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   t = Clock::now();
   r.classes.resize(n);
   r.colors_rgba.resize(4 * n);
+  const auto considered = [&input](size_t v) { return input.vertex_mask.empty() || input.vertex_mask[v] != 0; };
   for (size_t v = 0; v < n; ++v) {
     const CoverageClass c = classify_coverage(r.counts[v], settings.min_diffuse, settings.min_specular);
     r.classes[v] = c;
-    ++r.class_counts[c];
     const auto col = coverage_class_color(c);
     std::copy(col.begin(), col.end(), r.colors_rgba.begin() + std::ptrdiff_t(4 * v));
+    if (!considered(v)) continue;
+    ++r.vertices_considered;
+    ++r.class_counts[c];
   }
   const Viewpoint &vp = r.viewpoints[r.viewpoint];
   std::vector<uint16_t> fail_d, fail_s;
   prediction_failures(mesh, r.classes, vp, sources, settings.suggest, fail_d, fail_s);
+  for (size_t v = 0; v < n; ++v)
+    if (!considered(v)) fail_d[v] = fail_s[v] = 0;
   for (size_t v = 0; v < n; ++v) r.failed_diffuse += fail_d[v] > 0, r.failed_specular += fail_s[v] > 0;
-  const CoverageNeeds needs = coverage_needs(r.counts, input.dq.empty() ? nullptr : input.dq.data(),
-                                             input.sq.empty() ? nullptr : input.sq.data(), settings, fail_d.data(),
-                                             fail_s.data());
+  CoverageNeeds needs = coverage_needs(r.counts, input.dq.empty() ? nullptr : input.dq.data(),
+                                       input.sq.empty() ? nullptr : input.sq.data(), settings, fail_d.data(),
+                                       fail_s.data());
+  for (size_t v = 0; v < n; ++v)
+    if (!considered(v)) {
+      if (v < needs.diffuse.size()) needs.diffuse[v] = 0;
+      if (v < needs.specular.size()) needs.specular[v] = 0;
+    }
   r.poor_diffuse = needs.poor_diffuse, r.poor_specular = needs.poor_specular;
   std::vector<std::vector<uint8_t>> visible;
   for (const Viewpoint &viewpoint : r.viewpoints) visible.push_back(viewpoint_visible(masks, viewpoint));
@@ -291,7 +303,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   if (d_ok || s_ok) r.recommended = !s_ok || (d_ok && r.diffuse.covered_weight >= r.specular.covered_weight) ? 0 : 1;
   const std::vector<uint8_t> reasons = new_view_reasons(mesh, r.classes, visible, r.viewpoints, settings.suggest);
   for (size_t v = 0; v < n; ++v) {
-    if (!reasons[v]) continue;
+    if (!reasons[v] || !considered(v)) continue;
     r.new_view_vertices.push_back(uint32_t(v)), r.new_view_reasons.push_back(reasons[v]);
     bool clean = reasons[v] == kNewViewUnseen;
     for (size_t i = 0; i < visible.size() && !clean; ++i) clean = visible[i][v] != 0;

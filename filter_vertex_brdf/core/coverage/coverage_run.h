@@ -72,6 +72,9 @@ struct CoverageInput {
   std::string project_path;         // the .mlp (default paths; may be empty)
   std::vector<float> dq, sq;        // optional per-vertex fit quality in [0, 2] (empty: no fit)
   std::string quality_source;       // where dq/sq came from (report)
+  // "Only on selection": per vertex, 0 = left out: classified and coloured as usual, but it asks
+  // for no light, is never listed as needing a new viewpoint and is not counted. Empty: all.
+  std::vector<uint8_t> vertex_mask;
 };
 
 // Why a vertex can only be covered from a new viewpoint.
@@ -92,7 +95,8 @@ struct CoverageResult {
   std::vector<CoverageCounts> counts;      // per vertex
   std::vector<uint8_t> classes;            // per vertex, CoverageClass
   std::vector<uint8_t> colors_rgba;        // per vertex, coverage_class_color
-  size_t class_counts[4] = {0, 0, 0, 0};   // indexed by CoverageClass
+  size_t class_counts[4] = {0, 0, 0, 0};   // indexed by CoverageClass (vertices considered only)
+  size_t vertices_considered = 0;          // all, or the selected ones (CoverageInput::vertex_mask)
   std::vector<Viewpoint> viewpoints;
   size_t viewpoint = 0;                    // the suggestions' viewpoint (index into viewpoints)
   LightSuggestion diffuse, specular;       // next lights for that viewpoint (valid == false: none)

@@ -25,10 +25,11 @@ void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *f
       if ((s.flags & kMixedPixel) && !weak) continue;
       if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) continue;
       if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) ||
-          !std::isfinite(s.r_dot_e) || !std::isfinite(s.n_dot_l))
+          !std::isfinite(s.lobe_cos) || !std::isfinite(s.n_dot_l))
         continue;
-      const float w = s.n_dot_l * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
-      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.n_dot_l, 1.0f), s.r_dot_e, w, s.raster, s.flags});
+      const float w = s.n_dot_l * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
+      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.n_dot_l, 1.0f), s.lobe_cos, w, s.raster,
+                       uint16_t(s.flags | s.resolution << 10)});
     }
     end_[v] = data_.size();
   }
@@ -38,7 +39,10 @@ std::vector<Sample> MaterialSampleStore::as_samples(size_t v) const {
   std::vector<Sample> out;
   for (uint64_t k = begin_[v]; k < end_[v]; ++k) {
     const Entry &e = data_[k];
-    out.push_back({{e.rgb[0], e.rgb[1], e.rgb[2]}, e.d, e.s, e.raster, e.flags});
+    Sample smp{{e.rgb[0], e.rgb[1], e.rgb[2]}, e.d, e.s, e.raster, 0, 0};
+    smp.flags = e.flags & 0x3FFu;
+    smp.resolution = uint16_t(e.flags >> 10);
+    out.push_back(smp);
   }
   return out;
 }
@@ -302,8 +306,8 @@ void assign_labels(const Context &c, const Adjacency &adj, const std::vector<Sta
     const double var_v = S[v].n > 4 ? std::max(emin[v] / double(3 * S[v].n - 4), floor_var) : floor_var;
     for (int m = 1; m <= K; ++m) cost[size_t(m)][v] = (cost[size_t(m)][v] - emin[v]) / (2 * var_v);
   }
-  // Only vertices with a highlight sample (R.E > T_s) decide by their data: for the others the
-  // lobes differ only in their flanks, where the R.E form is least faithful. ICM among the deciding
+  // Only vertices with a highlight sample (kHighlight: R.E > T_s) decide by their data: for the others the
+  // lobes differ only in their flanks, where the lobe's form is least faithful. ICM among the deciding
   // vertices, then the others take the label of the nearest deciding vertices over the mesh.
   std::vector<uint8_t> decides(c.n, 0);
   for (size_t v = 0; v < c.n; ++v) {
@@ -499,10 +503,12 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
 }
 
 std::vector<uint8_t> diffuse_flags(const std::vector<LobeFit> &lobes, const std::vector<double> &median_kd, int K,
-                                   const MaterialOptions &mo) {
+                                   const MaterialOptions &mo, LobeForm form) {
   std::vector<uint8_t> d(size_t(K) + 1, 0);
+  // min_lobe_alpha is stated on R.E; an N.H exponent is about 4 times the R.E one for one lobe.
+  const double min_alpha = mo.min_lobe_alpha * (form == LobeForm::BlinnNH ? 4.0 : 1.0);
   for (int m = 1; m <= K; ++m)
-    d[size_t(m)] = lobes[size_t(m)].ks <= mo.diffuse_ks_fraction * median_kd[size_t(m)] || lobes[size_t(m)].alpha <= mo.min_lobe_alpha;
+    d[size_t(m)] = lobes[size_t(m)].ks <= mo.diffuse_ks_fraction * median_kd[size_t(m)] || lobes[size_t(m)].alpha <= min_alpha;
   return d;
 }
 
@@ -627,7 +633,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
       best_choice.push_back(best_choice.empty() ? choices.front() : best_choice.back());
       continue;
     }
-    const std::vector<uint8_t> diffuse = diffuse_flags(cfg.lobes, median_kd_of(c, fits, cfg.label, cfg.K), cfg.K, mo);
+    const std::vector<uint8_t> diffuse = diffuse_flags(cfg.lobes, median_kd_of(c, fits, cfg.label, cfg.K), cfg.K, mo, c.o.lobe);
     const std::vector<double> err = solve_vertices(c, S_train, S_held, kTrain, kHeld, cfg.label, cfg.lobes, diffuse, cfg.K, choices, nullptr);
     const size_t b = size_t(std::min_element(err.begin(), err.end()) - err.begin());
     const double best = err[b];
@@ -659,7 +665,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   for (int m = 1; m <= K; ++m) alpha_of[size_t(m)] = fin.lobes[size_t(m)].alpha;
   const std::vector<Lobe> L = lobe_sums(c, kAll, fin.label, alpha_of);
   const std::vector<double> median_kd = median_kd_of(c, fits, fin.label, K);
-  const std::vector<uint8_t> diffuse = diffuse_flags(fin.lobes, median_kd, K, mo);
+  const std::vector<uint8_t> diffuse = diffuse_flags(fin.lobes, median_kd, K, mo, c.o.lobe);
   Params P;
   solve_vertices(c, S, S, kAll, kAll, fin.label, fin.lobes, diffuse, K, {best_choice[chosen]}, &P);
 
@@ -711,7 +717,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     mat.lobe_gain = lf.energy_zero > 0 ? (lf.energy_zero - lf.energy) / lf.energy_zero : 0;
     rep << "  material " << m << ": " << mat.vertices << " vertices (" << mat.evidence_vertices
         << " with specular information of their own), " << mat.samples << " samples, " << mat.highlight_samples
-        << " highlight samples; pooled lobe k_s " << fixed(lf.ks, 4) << ", alpha (R.E) " << fixed(lf.alpha, 1)
+        << " highlight samples; pooled lobe k_s " << fixed(lf.ks, 4) << ", alpha (" << lobe_form_label(c.o.lobe) << ") " << fixed(lf.alpha, 1)
         << " (within 1 % of the best energy for alpha " << fixed(lf.alpha_lo, 1) << ".." << fixed(lf.alpha_hi, 1)
         << "), the lobe lowers the pooled energy by " << fixed(100 * mat.lobe_gain, 2) << " %; median k_d "
         << fixed(mat.median_kd, 4);

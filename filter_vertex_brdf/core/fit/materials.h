@@ -2,7 +2,7 @@
 // Materials found from the data, and a specular lobe per material (issue 16, first step).
 //
 // After the per-vertex Phong fit, the modelled vertices are grouped into a few materials by their
-// specular response, a lobe (k_s, alpha on R.E) is fitted per material from the pooled samples of
+// specular response, a lobe (k_s, alpha on the fit's lobe cosine, R.E or N.H) is fitted per material from the pooled samples of
 // all its vertices, and every vertex of a glossy material gets a specular term. A vertex whose own
 // fit found a lobe (fit_status 2, k_s > 0) keeps it (MaterialOptions::keep_full_fits, default);
 // every other vertex of a glossy material (or every one, keep_full_fits = false) gets
@@ -61,7 +61,7 @@ struct MaterialOptions {
   // per-vertex rule left them diffuse-only, or weak) take the material's lobe. false: every vertex
   // of a glossy material gets the material-regularised k_s and alpha.
   bool keep_full_fits = true;
-  // A pooled lobe with alpha at or below this is no highlight (R.E^alpha with alpha ~ 1 is a broad
+  // A pooled lobe with alpha at or below this (stated on R.E; 4x for the N.H form) is no highlight (R.E^alpha with alpha ~ 1 is a broad
   // cosine that only absorbs shading-model misfit): the material is treated as diffuse.
   float min_lobe_alpha = 2.0f;
   bool robust_colour = true;         // one 3-MAD outlier pass on k_d C with the lobe fixed (final fit only)
@@ -101,9 +101,9 @@ public:
   void add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o);
   struct Entry {
     float rgb[3];
-    float d, s, w;      // N.L, R.E, weight
+    float d, s, w;      // N.L, the lobe's cosine (R.E or N.H), weight (resolution weight included)
     uint16_t raster;
-    uint16_t flags;     // SampleFlag bits of the sample
+    uint16_t flags;     // SampleFlag bits of the sample | its Sample::resolution << 10
   };
   size_t vertex_count() const { return begin_.size(); }
   uint64_t first(size_t v) const { return begin_[v]; }  // index range [first, last) into entries()

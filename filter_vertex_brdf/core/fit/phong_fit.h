@@ -3,14 +3,16 @@
 // precision, OpenMP) and the GPU back end (shaders/phong_fit.comp, float32).
 //
 // Model, per colour channel c, light of unit irradiance and white colour (after calibration):
-//     f_c = k_d (N.L) C_c + k_s max(R.E, 0)^alpha
+//     f_c = k_d (N.L) C_c + k_s max(s, 0)^alpha,  s = R.E or N.H (options.lobe, samples/lobe.h)
 // Objective: sum over usable samples i of w_i * sum_c (P_ic - f_c)^2 + prior, with
-//     w_i = N.L_i (thesis ch. 5), highlight samples rescaled so that their total weight is at
+//     w_i = N.L_i (thesis ch. 5) times the sample's photo resolution weight (resolution_weight,
+//     1 with one camera), highlight samples rescaled so that their total weight is at
 //     most `specular_weight_cap` times the weight of the other samples (diffuse-hole remedy 1),
 //     prior = diffuse_prior * W * sum_c (rho_c - rho0_c)^2, rho = k_d C, rho0 the diffuse-only
 //     estimate, W the total weight (remedy 2: a weak pull towards the diffuse-only fit).
 // Usable samples: lit (no shadow flag), unsaturated, clean pixel (no kMixedPixel), N.L > 0, and
-// not grazing (kGrazing) unless a highlight. Highlight samples: R.E > T_s.
+// not grazing (kGrazing) unless a highlight. Highlight samples: s > lobe_threshold(lobe, T_s)
+// (R.E > T_s for the Phong form; the same cone in the plane of incidence for N.H).
 //
 // Method (variable projection of the thesis's 4.6 cycle): for fixed alpha the model is linear in
 // (rho_r, rho_g, rho_b, k_s), so the "(k_d, k_s)" and "colour" stages are solved exactly and
@@ -56,6 +58,9 @@ struct PhongFitOptions {
   // grazing samples (N.L < T_d) carry their N.L weight like any other, and contaminated
   // (kMixedPixel) samples count with this weight factor.
   float mixed_sample_weight = 0.25f;
+  // The lobe's form: which cosine Sample::lobe_cos holds and alpha applies to (lobe.h). The
+  // thresholds above stay stated on R.E and are converted by lobe_threshold().
+  LobeForm lobe = LobeForm::PhongRE;
 };
 
 enum FitStatus : uint8_t {
@@ -108,7 +113,7 @@ void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOp
                            VertexFit &fit);
 
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
-void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float out_rgb[3]);
+void evaluate_phong(const VertexFit &fit, float n_dot_l, float lobe_cos, float out_rgb[3]);
 
 // True when the vertex has a reflectance model (any status but kFitNone).
 inline bool has_model(const VertexFit &fit) { return fit.status != kFitNone; }

@@ -142,7 +142,7 @@ void diffuse_only_estimate(const std::vector<FitSample> &samples, double rho0[3]
     rho0[c] = std::max(0.0, (use_all ? dp_all[c] / std::max(dd_all, 1e-30) : dp[c] / dd));
 }
 
-void quality_metrics(const std::vector<FitSample> &samples, const VertexFit &fit, VertexFit &out) {
+void quality_metrics(const std::vector<FitSample> &samples, const VertexFit &fit, LobeForm form, VertexFit &out) {
   // Thesis 4.7.1: mean sampling term + (1 - mean weighted error / |white|^2), in [0, 2].
   double dq_term = 0, dq_err = 0, sq_term = 0, sq_err = 0, e = 0, w = 0;
   int nd = 0, ns = 0;
@@ -152,7 +152,8 @@ void quality_metrics(const std::vector<FitSample> &samples, const VertexFit &fit
     double err2 = 0;
     for (int c = 0; c < 3; ++c) err2 += (x.p[c] - f[c]) * (x.p[c] - f[c]);
     e += x.w * err2, w += x.w;
-    if (x.highlight) sq_term += x.s, sq_err += x.s * err2 / 3.0, ++ns;
+    const double s_re = lobe_as_r_dot_e(form, float(x.s));  // the thesis's R.E sampling term
+    if (x.highlight) sq_term += s_re, sq_err += s_re * err2 / 3.0, ++ns;
     else dq_term += x.d, dq_err += x.d * err2 / 3.0, ++nd;
   }
   auto quality = [](double term, double err, int n) {
@@ -177,9 +178,9 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 
 } // namespace
 
-void evaluate_phong(const VertexFit &fit, float n_dot_l, float r_dot_e, float out[3]) {
+void evaluate_phong(const VertexFit &fit, float n_dot_l, float lobe_cos, float out[3]) {
   const float d = std::max(n_dot_l, 0.0f);
-  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe(r_dot_e, fit.shininess)) : 0.0f;
+  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe(lobe_cos, fit.shininess)) : 0.0f;
   for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
 }
 
@@ -199,12 +200,13 @@ int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std
     // Grazing light (N.L < T_d) is as unreliable for the fit as for the basic colour (normal
     // errors, shading-model breakdown); a grazing highlight is still specular evidence.
     if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) continue;
-    if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.r_dot_e) ||
+    if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.lobe_cos) ||
         !std::isfinite(s.n_dot_l))
       continue;  // a corrupt sample is not evidence
-    const double w = s.n_dot_l * ((s.flags & kMixedPixel) ? double(o.mixed_sample_weight) : 1.0);
-    FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.r_dot_e, w,
-                s.r_dot_e > o.specular_threshold};
+    const double w =
+        s.n_dot_l * double(resolution_weight(s)) * ((s.flags & kMixedPixel) ? double(o.mixed_sample_weight) : 1.0);
+    FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.lobe_cos, w,
+                s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold)};
     (x.highlight ? w_high : w_other) += x.w;
     n_high += x.highlight;
     samples.push_back(x);
@@ -222,7 +224,7 @@ void set_diffuse_only_reflectance(const Sample *in, size_t count, const PhongFit
   for (int c = 0; c < 3; ++c) L.rho[c] = std::min(std::max(double(rho[c]), 0.0), double(o.kd_max));
   store_linear(L, 0, out);
   out.status = kFitDiffuseOnly;
-  quality_metrics(samples, out, out);
+  quality_metrics(samples, out, o.lobe, out);
 }
 
 namespace {
@@ -239,7 +241,8 @@ void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool w
       if (x.highlight) x.w *= scale;
   }
   int n_lobe = 0;
-  for (const FitSample &x : samples) n_lobe += x.s > o.lobe_threshold;
+  const double broad = lobe_threshold(o.lobe, o.lobe_threshold);
+  for (const FitSample &x : samples) n_lobe += x.s > broad;
   const bool ks_free = n_high >= o.min_specular_samples || n_lobe >= o.min_lobe_samples;
   // Remedy 3: too little specular evidence to free k_s and alpha: the few highlight samples
   // cannot be explained by a diffuse-only model, so they are left out (if anything else remains).
@@ -297,7 +300,7 @@ void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool w
   out.status = out.ks > 0 ? kFitFull : kFitDiffuseOnly;
   out.iterations = uint16_t(it);
   out.converged = converged ? 1 : 0;
-  quality_metrics(samples, out, out);
+  quality_metrics(samples, out, o.lobe, out);
 }
 } // namespace
 
@@ -317,7 +320,7 @@ void recompute_fit_quality(const Sample *in, size_t count, const PhongFitOptions
   std::vector<FitSample> samples;
   double w_high, w_other;
   usable_samples(in, count, o, samples, w_high, w_other, weak);
-  quality_metrics(samples, fit, fit);
+  quality_metrics(samples, fit, o.lobe, fit);
   if (weak) fit.dq *= 0.5f, fit.sq *= 0.5f;
 }
 

@@ -20,9 +20,10 @@
 namespace vbrdf {
 
 // The shader reads and writes these structs as raw words (little-endian hosts: the uint16/uint8
-// fields pack into one uint as raster | flags << 16 and iterations | status << 16 | converged << 24).
-static_assert(sizeof(Sample) == 24 && offsetof(Sample, raster) == 20 && offsetof(Sample, flags) == 22,
-              "Sample layout must match shaders/phong_fit.comp");
+// fields pack into one uint as raster | flags << 16 | resolution << 26 (bit-fields: the word's layout
+// is checked by tests/unit/test_samples.cpp SampleWordMatchesTheShader) and iterations | status << 16
+// | converged << 24).
+static_assert(sizeof(Sample) == 24 && offsetof(Sample, raster) == 20, "Sample layout must match shaders/phong_fit.comp");
 static_assert(sizeof(VertexFit) == 40 && offsetof(VertexFit, kd) == 12 && offsetof(VertexFit, rmse) == 32 &&
                   offsetof(VertexFit, iterations) == 36 && offsetof(VertexFit, status) == 38 &&
                   offsetof(VertexFit, converged) == 39,
@@ -44,7 +45,7 @@ std::string phong_fit_source() { return shaders::phong_fit_comp; }
 struct Uniforms {
   GLint vertex_count = -1, sample_base = -1, alpha_init = -1, alpha_min = -1, alpha_max = -1;
   GLint tolerance = -1, weight_cap = -1, prior = -1, kd_max = -1, ks_max = -1, threshold = -1;
-  GLint max_iterations = -1, min_specular = -1, min_lobe = -1, lobe_threshold = -1;
+  GLint max_iterations = -1, min_specular = -1, min_lobe = -1, lobe_threshold = -1, half_angle = -1;
 };
 
 // One set of buffers for a dispatch batch.
@@ -53,35 +54,6 @@ struct Slot {
   GLsizeiptr samples_capacity = 0, offsets_capacity = 0, fits_capacity = 0, order_capacity = 0;
   uint32_t first = 0, count = 0;  // vertex range of the batch in flight
   bool pending = false;           // dispatched, not yet read back
-};
-
-// Saves and restores the SSBO bindings the pass uses (GlStateGuard does not cover them).
-class SsboBindingGuard {
-public:
-  explicit SsboBindingGuard(const GlApi &gl) : gl_(gl) {
-    gl.GetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
-    for (GLuint i = 0; i < kCount; ++i) {
-      gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &buffer_[i]);
-      gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_START, i, &start_[i]);
-      gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_SIZE, i, &size_[i]);
-    }
-  }
-  ~SsboBindingGuard() {
-    for (GLuint i = 0; i < kCount; ++i) {
-      if (buffer_[i] && size_[i] > 0)
-        gl_.BindBufferRange(GL_SHADER_STORAGE_BUFFER, i, GLuint(buffer_[i]), start_[i], size_[i]);
-      else
-        gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(buffer_[i]));
-    }
-    gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(generic_));
-  }
-  SsboBindingGuard(const SsboBindingGuard &) = delete;
-  SsboBindingGuard &operator=(const SsboBindingGuard &) = delete;
-
-private:
-  static constexpr GLuint kCount = 4;  // bindings 0..3
-  const GlApi &gl_;
-  GLint generic_ = 0, buffer_[kCount] = {}, start_[kCount] = {}, size_[kCount] = {};
 };
 
 // Throws unless the chunk's CSR arrays are consistent: the shader trusts them for its loop bounds.
@@ -120,8 +92,8 @@ void work_order(const SampleChunk &chunk, uint32_t first, uint32_t end, const Ph
     for (uint32_t k = chunk.offsets[first + i]; k < chunk.offsets[first + i + 1]; ++k) {
       const Sample &s = chunk.samples[k];
       const bool usable = !(s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) && s.n_dot_l > 0;
-      n_high += usable && s.r_dot_e > o.specular_threshold;
-      n_lobe += usable && s.r_dot_e > o.lobe_threshold;
+      n_high += usable && s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold);
+      n_lobe += usable && s.lobe_cos > lobe_threshold(o.lobe, o.lobe_threshold);
     }
     return n_high >= o.min_specular_samples || n_lobe >= o.min_lobe_samples;
   };
@@ -175,7 +147,7 @@ PhongFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_p
                  {&u.kd_max, "u_kd_max"},             {&u.ks_max, "u_ks_max"},
                  {&u.threshold, "u_specular_threshold"}, {&u.max_iterations, "u_max_iterations"},
                  {&u.min_specular, "u_min_specular"}, {&u.min_lobe, "u_min_lobe"},
-                 {&u.lobe_threshold, "u_lobe_threshold"}};
+                 {&u.lobe_threshold, "u_lobe_threshold"}, {&u.half_angle, "u_half_angle_lobe"}};
     for (const auto &n : names) {
       *n.location = gl.GetUniformLocation(program, n.name);
       if (*n.location < 0)
@@ -221,11 +193,12 @@ void PhongFitGpu::Impl::set_options(const PhongFitOptions &o) const {
   gl.Uniform1f(u.prior, o.diffuse_prior);
   gl.Uniform1f(u.kd_max, o.kd_max);
   gl.Uniform1f(u.ks_max, o.ks_max);
-  gl.Uniform1f(u.threshold, o.specular_threshold);
+  gl.Uniform1f(u.threshold, lobe_threshold(o.lobe, o.specular_threshold));
   gl.Uniform1i(u.max_iterations, o.max_iterations);
   gl.Uniform1i(u.min_specular, o.min_specular_samples);
   gl.Uniform1i(u.min_lobe, o.min_lobe_samples);
-  gl.Uniform1f(u.lobe_threshold, o.lobe_threshold);
+  gl.Uniform1f(u.lobe_threshold, lobe_threshold(o.lobe, o.lobe_threshold));
+  gl.Uniform1i(u.half_angle, o.lobe == LobeForm::BlinnNH ? 1 : 0);
 }
 
 // End of the batch starting at vertex `first`: at most batch_vertices vertices and batch_bytes of

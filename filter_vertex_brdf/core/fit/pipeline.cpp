@@ -13,6 +13,7 @@
 #include "calibration/color_plan.h"
 #include "inputs/light_file.h"
 #include "inputs/light_source.h"
+#include "inputs/photo_prefetch.h"
 #include "io/fit_outputs.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
@@ -26,6 +27,9 @@ std::string default_output_path(const std::string &project_path) {
 
 void validate_input(const FitInput &input) {
   validate_mesh(input.mesh, input.mesh_name);
+  if (!input.vertex_mask.empty() && input.vertex_mask.size() != input.mesh.vertex_count)
+    throw InputError("internal: the vertex selection has " + std::to_string(input.vertex_mask.size()) +
+                     " entries for " + std::to_string(input.mesh.vertex_count) + " vertices");
   if (input.rasters.empty())
     throw InputError("The project has no rasters: load the registered photos (File > Import Raster) or open the .mlp.");
   for (size_t r = 0; r < input.rasters.size(); ++r) {
@@ -135,6 +139,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   validate_input(input);
   FitSettings settings = settings_in;
   settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
+  settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
   if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
   const MeshView &mesh = input.mesh;
   FitResult result;
@@ -170,8 +175,24 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   result.normals_source = describe_normals_source(input.mesh_path);
   log(result.normals_source + ".");
 
-  // Photos are validated (size, bit depth, content) before the long passes start.
+  // The photos decode in the background while the GL passes run (photo_prefetch.h); a photo that
+  // cannot be decoded fails before any sample is gathered, so before anything is written.
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
+  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);
+  // Before the long passes: a required chart that is missing fails early.
+  if (progress) progress(0.0f, "colour calibration");
+  ColorPlan colors = plan_colors(input, settings, light_directions(lights), photos, log);
+  const bool correct = colors.any_corrected();
+  result.color_viewpoints_corrected = size_t(std::count_if(
+      colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
+
+  auto t = Clock::now();
+  const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
+  VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
+  restrict_to_vertices(masks, input.vertex_mask);
+  result.seconds_visibility = seconds_since(t);
+  prefetch->finish();
+  // Every photo's content (photo_content.h), before any sample is gathered: mostly from the cache.
   std::vector<PhotoContent> contents;
   size_t largest_photo = 0;
   for (const Raster &r : input.rasters) {
@@ -188,17 +209,6 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   }
   result.warnings = check_photo_contents(input.rasters, contents);
   for (const std::string &w : result.warnings) log(w);
-  // Before the long passes: a required chart that is missing fails early.
-  if (progress) progress(0.0f, "colour calibration");
-  ColorPlan colors = plan_colors(input, settings, light_directions(lights), photos, log);
-  const bool correct = colors.any_corrected();
-  result.color_viewpoints_corrected = size_t(std::count_if(
-      colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
-
-  auto t = Clock::now();
-  const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
-  const VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
-  result.seconds_visibility = seconds_since(t);
   if (std::all_of(masks.seen_count.begin(), masks.seen_count.end(), [](uint32_t c) { return c == 0; }))
     throw InputError("No raster's camera sees the mesh (every vertex is outside every photo, behind its camera or "
                      "back-facing): the registration does not match this mesh. Check that the project's rasters "

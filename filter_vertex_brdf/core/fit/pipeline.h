@@ -34,8 +34,16 @@ enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
 // and little more below. Coverage keeps 0.5: it asks the photographer for well-lit samples.
 constexpr float kFitDiffuseThreshold = 0.2f;
 
+// The product's lobe form (the filter's and vbrdf_fit's default; README "The lobe's form and several
+// cameras" has the measurements that chose it). PhongFitOptions keeps the thesis's R.E as the
+// core contract's default; the pipeline copies phong.lobe into gather.lobe.
+constexpr LobeForm kFitLobe = LobeForm::BlinnNH;
+
 struct FitSettings {
-  FitSettings() { gather.diffuse_threshold = kFitDiffuseThreshold; }
+  FitSettings() {
+    gather.diffuse_threshold = kFitDiffuseThreshold;
+    phong.lobe = gather.lobe = kFitLobe;
+  }
   GatherSettings gather;
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;
@@ -74,6 +82,9 @@ struct FitInput {
   std::vector<uint8_t> mesh_colors;    // RGBA8 per vertex (current colours, kept where unseen)
   std::vector<Raster> rasters;
   std::string project_path;            // the .mlp, used for default paths (may be empty)
+  // "Only on selection": per vertex, 0 = leave out (no sample is taken: it reads as seen by no
+  // photo, keeps its input colour, fit_status 0 unless fillUnseenRings reaches it). Empty: all.
+  std::vector<uint8_t> vertex_mask;
 };
 
 

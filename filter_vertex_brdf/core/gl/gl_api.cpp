@@ -314,4 +314,23 @@ GlStateGuard::~GlStateGuard() {
   gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(draw_fbo_));
 }
 
+SsboBindingGuard::SsboBindingGuard(const GlApi &gl) : gl_(gl) {
+  gl.GetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
+  for (GLuint i = 0; i < kCount; ++i) {
+    gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &buffer_[i]);
+    gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_START, i, &start_[i]);
+    gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_SIZE, i, &size_[i]);
+  }
+}
+
+SsboBindingGuard::~SsboBindingGuard() {
+  for (GLuint i = 0; i < kCount; ++i) {
+    if (buffer_[i] && size_[i] > 0)
+      gl_.BindBufferRange(GL_SHADER_STORAGE_BUFFER, i, GLuint(buffer_[i]), start_[i], size_[i]);
+    else
+      gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(buffer_[i]));
+  }
+  gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(generic_));
+}
+
 } // namespace vbrdf

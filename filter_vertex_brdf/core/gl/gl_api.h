@@ -205,4 +205,19 @@ private:
   int cap_count_ = 0;
 };
 
+// Saves and restores the shader-storage buffer bindings 0..3 and the generic SSBO binding of a
+// compute pass (GlStateGuard does not cover them). Needs has_compute.
+class SsboBindingGuard {
+public:
+  explicit SsboBindingGuard(const GlApi &gl);
+  ~SsboBindingGuard();
+  SsboBindingGuard(const SsboBindingGuard &) = delete;
+  SsboBindingGuard &operator=(const SsboBindingGuard &) = delete;
+
+private:
+  static constexpr GLuint kCount = 4;  // bindings 0..3
+  const GlApi &gl_;
+  GLint generic_ = 0, buffer_[kCount] = {}, start_[kCount] = {}, size_[kCount] = {};
+};
+
 } // namespace vbrdf

@@ -143,17 +143,46 @@ PhotoCache::PhotoCache(PhotoEncoding encoding, float saturation_level, size_t bu
     : encoding_(encoding), saturation_level_(saturation_level), budget_(budget_bytes) {}
 
 std::shared_ptr<const Photo> PhotoCache::get(const std::string &path, int expected_width, int expected_height) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  ++tick_;
-  for (auto &e : entries_)
-    if (e.first == path) {
-      e.second.last_use = tick_;
-      return e.second.photo;
-    }
-  auto photo = std::make_shared<const Photo>(
-      load_photo(path, encoding_, saturation_level_, expected_width, expected_height));
+  return load(path, expected_width, expected_height, false);
+}
+
+std::shared_ptr<const Photo> PhotoCache::prefetch(const std::string &path, int expected_width, int expected_height) {
+  return load(path, expected_width, expected_height, true);
+}
+
+std::shared_ptr<const Photo> PhotoCache::load(const std::string &path, int expected_width, int expected_height,
+                                              bool only_if_room) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    ++tick_;
+    for (auto &e : entries_)
+      if (e.first == path) {
+        e.second.last_use = tick_;
+        return e.second.photo;
+      }
+    if (std::find(loading_.begin(), loading_.end(), path) == loading_.end()) break;
+    loaded_.wait(lock);  // another thread decodes it
+  }
+  // Room for it and for the photos being decoded, each as large as the largest so far (checked
+  // with the decode registered under one lock, so that prefetching threads never overshoot).
+  const bool busy = !entries_.empty() || !loading_.empty();
+  if (only_if_room && busy && used_ + largest_ * (loading_.size() + 1) > budget_) return nullptr;
+  loading_.push_back(path);
+  lock.unlock();
+  std::shared_ptr<const Photo> photo;
+  try {
+    photo = std::make_shared<const Photo>(load_photo(path, encoding_, saturation_level_, expected_width, expected_height));
+  } catch (...) {
+    lock.lock();
+    loading_.erase(std::find(loading_.begin(), loading_.end(), path));
+    loaded_.notify_all();
+    throw;
+  }
+  lock.lock();
+  loading_.erase(std::find(loading_.begin(), loading_.end(), path));
   ++loads_;
   const size_t bytes = photo->pixels.total() * photo->pixels.elemSize() + photo->lut.size() * sizeof(float);
+  largest_ = std::max(largest_, bytes);
   // Evict least recently used photos until the new one fits (a photo in use elsewhere stays
   // alive through its shared_ptr even when evicted).
   while (!entries_.empty() && used_ + bytes > budget_) {
@@ -163,9 +192,11 @@ std::shared_ptr<const Photo> PhotoCache::get(const std::string &path, int expect
     used_ -= oldest->second.bytes;
     entries_.erase(oldest);
   }
-  entries_.push_back({path, Entry{photo, bytes, tick_}});
+  entries_.push_back({path, Entry{photo, bytes, ++tick_}});
   used_ += bytes;
+  loaded_.notify_all();
   return photo;
 }
+
 
 } // namespace vbrdf

@@ -5,6 +5,8 @@
 // decodes on sampling) so that hundreds of photos fit in memory.
 #include <cstdint>
 #include <memory>
+#include <atomic>
+#include <condition_variable>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -59,21 +61,30 @@ struct PixelSample {
 PixelSample sample_bilinear(const Photo &photo, float x, float y, uint8_t texels = 0xF);
 
 // Keeps decoded photos under a memory budget (least recently used are dropped and reloaded on
-// demand). Thread-safe.
+// demand). Thread-safe: photos are decoded outside the lock, several at once from several threads;
+// a thread asking for a photo that another is decoding waits for it (one decode per photo).
 class PhotoCache {
 public:
   PhotoCache(PhotoEncoding encoding, float saturation_level, size_t budget_bytes);
   // Returns the photo of `path`, loading it if needed (validating its size when given).
   std::shared_ptr<const Photo> get(const std::string &path, int expected_width = 0, int expected_height = 0);
   size_t loads() const { return loads_; }  // number of decodes performed (for the report)
+  // As get, but only when the photo fits beside the cached ones and those being decoded (each
+  // counted as large as the largest so far) without evicting any: else nullptr, nothing decoded.
+  std::shared_ptr<const Photo> prefetch(const std::string &path, int expected_width = 0, int expected_height = 0);
 
 private:
+  std::shared_ptr<const Photo> load(const std::string &path, int expected_width, int expected_height, bool only_if_room);
+
   PhotoEncoding encoding_;
   float saturation_level_;
   size_t budget_;
   size_t used_ = 0;
-  size_t loads_ = 0;
+  std::atomic<size_t> loads_{0};
+  size_t largest_ = 0;
   unsigned long tick_ = 0;
+  std::vector<std::string> loading_;  // paths being decoded now
+  std::condition_variable loaded_;
   struct Entry { std::shared_ptr<const Photo> photo; size_t bytes; unsigned long last_use; };
   std::vector<std::pair<std::string, Entry>> entries_;
   std::mutex mutex_;

@@ -116,14 +116,17 @@ void build_coverage_texts(const CoverageInput &input, const CoverageSettings &se
       << settings.gather.diffuse_threshold << "; covered = at least " << settings.min_diffuse << " diffuse / "
       << settings.min_specular << " specular sample(s); lights at least " << settings.suggest.min_elevation_deg
       << " deg above the image plane\n"
+      << (r.vertices_considered < n ? "only on selection: " + std::to_string(r.vertices_considered) + " of " +
+                                          std::to_string(n) + " vertices considered (counts below are of these)\n"
+                                    : std::string())
       << "legend (vertex colours) and counts:\n";
   static const char *const keys[4] = {"unseen", "seen_not_diffuse", "diffuse_no_specular", "fully_covered"};
-  static const char *const colour_names[4] = {"purple", "red", "yellow", "green"};
+  static const char *const colour_names[4] = {"purple", "blue", "yellow", "green"};
   for (int c = 0; c < 4; ++c) {
     const auto col = coverage_class_color(CoverageClass(c));
     rep << "  " << colour_names[c] << " (" << int(col[0]) << "," << int(col[1]) << "," << int(col[2])
         << "): " << coverage_class_name(CoverageClass(c)) << ": " << r.class_counts[c] << " ("
-        << percent(r.class_counts[c], n) << ")\n";
+        << percent(r.class_counts[c], r.vertices_considered) << ")\n";
   }
   if (!input.dq.empty())
     rep << "fit quality (" << (input.quality_source.empty() ? "per-vertex dq/sq" : input.quality_source)

@@ -58,6 +58,32 @@ bool displayed_reflectance(const FitResult &r, size_t v, float rho[3]) {
 
 std::string report_path_for(const std::string &ply) { return strip_extension(ply) + "_report.txt"; }
 
+void neutral_quality_for_unmodelled(const std::vector<VertexFit> &fits, std::vector<float> &quality) {
+  std::vector<float> modelled;
+  for (size_t v = 0; v < fits.size() && v < quality.size(); ++v)
+    if (fits[v].status != kFitNone && std::isfinite(quality[v])) modelled.push_back(quality[v]);
+  float neutral = 0.0f;
+  if (!modelled.empty()) {
+    std::nth_element(modelled.begin(), modelled.begin() + std::ptrdiff_t(modelled.size() / 2), modelled.end());
+    neutral = modelled[modelled.size() / 2];
+  }
+  for (size_t v = 0; v < fits.size() && v < quality.size(); ++v)
+    if (fits[v].status == kFitNone || !std::isfinite(quality[v])) quality[v] = neutral;
+}
+
+namespace {
+
+// The report's line for "only on selection" ("" when every vertex took part).
+std::string only_on_selection(const FitInput &input) {
+  if (input.vertex_mask.empty()) return "";
+  const size_t kept =
+      size_t(std::count_if(input.vertex_mask.begin(), input.vertex_mask.end(), [](uint8_t m) { return m != 0; }));
+  return "only on selection: " + std::to_string(kept) + " of " + std::to_string(input.vertex_mask.size()) +
+         " vertices fitted (the others are left out, as if no photo saw them)\n";
+}
+
+} // namespace
+
 void build_outputs(const FitInput &input, const FitSettings &settings, FitResult &r) {
   const size_t n = input.mesh.vertex_count;
   r.colors_rgba.assign(4 * n, 0);
@@ -79,6 +105,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
       rec.fit = f;
+      rec.lobe_form = float(uint8_t(settings.phong.lobe));
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -96,6 +123,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       if (e.n_seen == 0) ++r.vertices_unseen; else ++r.vertices_no_diffuse;
     }
   }
+  if (!r.fits.empty()) neutral_quality_for_unmodelled(r.fits, r.quality);
   r.attributes = result_attributes(records, !r.fits.empty());  // by name, in the schema's file order
 }
 
@@ -107,6 +135,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   rep << "filter_vertex_brdf report\n";
   for (const std::string &w : r.warnings) rep << w << "\n";
   rep << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
+      << only_on_selection(input)
       << r.normals_source << "\n"
       << (r.memory_note.empty() ? std::string() : r.memory_note + "\n")
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
@@ -131,6 +160,10 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   for (const auto &f : flag_names)
     rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
   rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
+  if (settings.fit_reflectance)
+    rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
+        << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
+        << "); samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off") << "\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"

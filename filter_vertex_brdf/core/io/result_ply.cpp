@@ -114,13 +114,15 @@ ResultPly read_result_ply(const std::string &path) {
   return r;
 }
 
-std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path) {
+std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe) {
   const std::string missing = first_missing_model_attribute(result.vertex_properties);
   if (!missing.empty())
     throw InputError("Result '" + path + "' has no per-vertex '" + missing +
                      "': run the fit with 'Fit Phong reflectance' on first.");
   std::vector<VertexFit> fits;
-  for (const VertexRecord &record : records_from_columns(result.vertex_properties, path)) fits.push_back(record.fit);
+  const std::vector<VertexRecord> records = records_from_columns(result.vertex_properties, path);
+  for (const VertexRecord &record : records) fits.push_back(record.fit);
+  if (lobe) *lobe = lobe_form_of(records, path);
   return fits;
 }
 

@@ -59,6 +59,10 @@ std::vector<ResultAttribute> make_schema() {
       {"material", K::Code, G::PhongFit, false,
        "material found from the data (materials = on): 1..K, listed in the report; 0 none (stage off, or no model)",
        [](const R &r) { return r.material; }, [](R &r, float v) { r.material = whole(v, 65535.0f); }},
+      {"lobe_form", K::Code, G::PhongFit, false,
+       "the specular lobe's form that shininess applies to: 0 Phong on R.E (the thesis), 1 Blinn-Phong on N.H "
+       "(absent: 0)",
+       [](const R &r) { return r.lobe_form; }, [](R &r, float v) { r.lobe_form = whole(v, 1.0f); }},
   };
 }
 } // namespace
@@ -112,6 +116,15 @@ std::vector<VertexRecord> records_from_columns(const ResultColumns &columns, con
     for (size_t v = 0; v < n; ++v) a.set(records[v], it->second[v]);
   }
   return records;
+}
+
+LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
+  bool seen[2] = {false, false};
+  for (const VertexRecord &r : records)
+    if (has_model(r.fit)) seen[r.lobe_form > 0.5f ? 1 : 0] = true;
+  if (seen[0] && seen[1])
+    throw InputError("Result '" + source + "' mixes lobe forms (per-vertex 'lobe_form' 0 and 1): refit it in one run.");
+  return seen[1] ? LobeForm::BlinnNH : LobeForm::PhongRE;
 }
 
 } // namespace vbrdf

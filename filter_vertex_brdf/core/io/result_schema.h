@@ -22,6 +22,7 @@ struct VertexRecord {
   float n_visible = 0.0f, n_diffuse = 0.0f, n_specular = 0.0f;
   float coloured = 0.0f;  // 0 input colour kept, 1 clean pixels, 2 rim/mixed pixels only, 3 neighbours
   float material = 0.0f;  // material stage (materials.h): 1..K, 0 = none (stage off, or no model)
+  float lobe_form = 0.0f;  // LobeForm of the fit (samples/lobe.h): 0 R.E, 1 N.H; one value per result
   VertexFit fit = {{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0, kFitNone, 0};  // sentinels
 };
 
@@ -64,5 +65,10 @@ std::string first_missing_model_attribute(const ResultColumns &columns);
 // is the longest column of the schema (0 when none). Throws InputError naming `source` and the
 // attribute when a schema column has another length. Columns outside the schema are ignored.
 std::vector<VertexRecord> records_from_columns(const ResultColumns &columns, const std::string &source);
+
+// The lobe form of a result (the 'lobe_form' of its modelled vertices; PhongRE when absent, as in
+// files written before the attribute existed). Throws InputError naming `source` when the
+// modelled vertices disagree.
+LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source);
 
 } // namespace vbrdf

@@ -66,6 +66,7 @@ in vec2 v_ks_alpha;
 in float v_depth;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
+uniform int u_half_angle_lobe;
 uniform mat4 u_light_view;
 uniform float u_light_scale;
 uniform int u_light_perspective;
@@ -110,8 +111,9 @@ void main() {
                         max(shadow_texel(i0, j0 + 1), shadow_texel(i0 + 1, j0 + 1)));
   if (light_depth > far_depth + u_tolerance) { o_color = vec4(0.0, 0.0, 0.0, 2.0); return; }
   vec3 e = normalize(u_eye - v_position);
-  vec3 r = 2.0 * d * n - l;
-  float s = dot(r, e);
+  // The lobe's cosine (samples/lobe.h lobe_cosine): R.E, or N.H when u_half_angle_lobe.
+  vec3 h = l + e;
+  float s = u_half_angle_lobe != 0 ? (dot(h, h) > 1e-12 ? dot(n, h) / length(h) : 0.0) : dot(2.0 * d * n - l, e);
   float spec = 0.0;
   if (v_ks_alpha.x > 0.0 && s > 0.0)
     spec = v_ks_alpha.x * exp(max(v_ks_alpha.y * log(min(s, 1.0)), -80.0));
@@ -309,6 +311,7 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, projection.m);
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
+  gl_.Uniform1i(gl_.GetUniformLocation(p, "u_half_angle_lobe"), settings_.lobe == LobeForm::BlinnNH ? 1 : 0);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), lv.scale);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_light_perspective"), lv.perspective ? 1 : 0);

@@ -132,10 +132,30 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
   return masks;
 }
 
+void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &vertex_mask) {
+  if (vertex_mask.empty()) return;
+  if (vertex_mask.size() != masks.vertex_count)
+    throw InputError("internal: vertex mask of " + std::to_string(vertex_mask.size()) + " entries for " +
+                     std::to_string(masks.vertex_count) + " vertices");
+  const size_t words = masks.words();
+  std::vector<uint64_t> keep(words, 0);
+  for (size_t v = 0; v < vertex_mask.size(); ++v)
+    if (vertex_mask[v]) keep[v / 64] |= uint64_t(1) << (v % 64);
+  for (size_t r = 0; r < masks.raster_count; ++r) {
+    uint32_t seen = 0;
+    for (size_t w = 0; w < words; ++w) {
+      for (std::vector<uint64_t> *bits : {&masks.seen, &masks.lit, &masks.mixed})
+        if (bits->size() == masks.raster_count * words) (*bits)[r * words + w] &= keep[w];
+      seen += uint32_t(__builtin_popcountll(masks.seen[r * words + w]));
+    }
+    if (r < masks.seen_count.size()) masks.seen_count[r] = seen;
+  }
+}
+
 uint16_t make_sample(const float position[3], const float normal_in[3], const Raster &raster, uint16_t raster_index,
                      const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
                      const GatherSettings &settings, Sample &out, uint8_t own_texels) {
-  out = Sample{{0, 0, 0}, 0, 0, raster_index, 0};
+  out = Sample{{0, 0, 0}, 0, 0, raster_index, 0, 0};
   float n[3] = {normal_in[0], normal_in[1], normal_in[2]};
   normalize3(n);
   float centre[3];
@@ -153,10 +173,9 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
   float light_dir[3];
   light_direction_at(light, position, light_dir);
   const float d = dot3(n, light_dir);
-  const float r[3] = {2 * d * n[0] - light_dir[0], 2 * d * n[1] - light_dir[1], 2 * d * n[2] - light_dir[2]};
-  const float s = dot3(r, e);
+  const float s = lobe_cosine(LobeForm::PhongRE, n, light_dir, e);  // R.E: decides kHighlight
   out.n_dot_l = d;
-  out.r_dot_e = s;
+  out.lobe_cos = settings.lobe == LobeForm::PhongRE ? s : lobe_cosine(settings.lobe, n, light_dir, e);
   if (d <= 0) flags |= kAttachedShadow;
   if (!light_clear) flags |= kCastShadow;
   if (d > 0 && d < settings.diffuse_threshold) flags |= kGrazing;
@@ -172,8 +191,21 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
     if (px.saturated) flags |= kSaturated;
     for (int c = 0; c < 3; ++c) out.rgb[c] = px.rgb[c];
   }
-  out.flags = flags;
+  out.flags = flags & 0x3FFu;
   return flags;
+}
+
+float photo_resolution(const Raster &raster, const float position[3], const float n[3]) {
+  float centre[3];
+  camera_centre(raster.shot, centre);
+  const float e[3] = {centre[0] - position[0], centre[1] - position[1], centre[2] - position[2]};
+  const float dist2 = dot3(e, e);
+  const float nl = std::sqrt(dot3(n, n));
+  if (!(dist2 > 0) || !(nl > 0)) return 0.0f;
+  const float ne = dot3(n, e) / (nl * std::sqrt(dist2));
+  if (!(ne > 0)) return 0.0f;
+  const float f = raster.shot.Intrinsics.FocalMm / raster.shot.Intrinsics.PixelSizeMm[0];
+  return f * f / dist2 * ne;
 }
 
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
@@ -222,11 +254,19 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     chunk.vertex_count = uint32_t(count);
     chunk.offsets.assign(count + 1, 0);
     chunk.samples.clear();
+    std::vector<float> resolution(rasters.size(), 0.0f);
     for (size_t i = 0; i < count; ++i) {
+      const float *p = mesh.positions + 3 * (first + i), *n = mesh.normals + 3 * (first + i);
+      float best = 0;
+      if (settings.resolution_weights)
+        for (size_t r = 0; r < rasters.size(); ++r)
+          if (!(dense[i * rasters.size() + r].flags & kNotSeen))
+            best = std::max(best, resolution[r] = photo_resolution(rasters[r], p, n));
       for (size_t r = 0; r < rasters.size(); ++r) {
-        const Sample &s = dense[i * rasters.size() + r];
+        Sample &s = dense[i * rasters.size() + r];
         if (s.flags & kNotSeen) continue;
         for (uint16_t f = s.flags; f; f &= uint16_t(f - 1)) ++stats.flag_counts[bit_index(uint16_t(f & -f))];
+        s.resolution = best > 0 ? resolution_code(resolution[r] / best) : 0;
         chunk.samples.push_back(s);
         ++stats.raster_seen_vertices[r];
       }

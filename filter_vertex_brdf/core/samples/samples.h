@@ -6,6 +6,7 @@
 // (2 bits per vertex and photo); pixel samples are then produced per vertex chunk, so the number
 // of photos and vertices is limited by disk and time, not by memory. A sample is 24 bytes.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "base/callbacks.h"  // ProgressFn
 #include "inputs/camera.h"
+#include "samples/lobe.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
 #include "inputs/photo.h"
@@ -40,11 +42,31 @@ constexpr uint16_t kShadowed = kAttachedShadow | kCastShadow;
 struct Sample {
   float rgb[3];      // linear pixel colour (bilinear)
   float n_dot_l;     // d = N.L
-  float r_dot_e;     // s = R.E, R = 2(N.L)N - L, E = unit vector from the vertex to the camera centre
+  float lobe_cos;    // s: the specular lobe's cosine, R.E or N.H (GatherSettings::lobe, lobe.h);
+                     //   E = unit vector from the vertex to the camera centre
   uint16_t raster;   // index of the photo
-  uint16_t flags;    // SampleFlag bits
+  uint16_t flags : 10;      // SampleFlag bits
+  uint16_t resolution : 6;  // how well this photo resolves the vertex, relative to the vertex's
+                            //   best-resolving photo: weight 2^(-resolution/8) (resolution_weight)
 };
 static_assert(sizeof(Sample) == 24, "Sample must stay compact");
+
+// The fit's weight factor for a sample's photo resolution: 1 for the photos that resolve the
+// vertex best (and for every sample when all its photos see it alike, e.g. one camera), down to
+// 2^(-63/8) = 0.004. See gather_samples for how the code is set.
+inline float resolution_weight(const Sample &s) { return std::exp2(-float(s.resolution) / 8.0f); }
+// The code of a resolution ratio in (0, 1] (1 = the best photo of the vertex): round(-8 log2 ratio),
+// clamped to [0, 63]; a non-finite or non-positive ratio gives 63.
+inline uint16_t resolution_code(float ratio) {
+  if (!(ratio > 0)) return 63;
+  const float q = std::round(-8.0f * std::log2(std::fmin(ratio, 1.0f)));
+  return uint16_t(std::fmin(std::fmax(q, 0.0f), 63.0f));
+}
+// How finely the photo of `raster` resolves a surface point at `position` with unit normal `n`:
+// pixels per unit surface area, (f / dist)^2 N.E (f: focal length in pixels, dist: distance to
+// the camera centre), as MeshLab's colour projection weights by angle and depth. 0 when
+// back-facing.
+float photo_resolution(const Raster &raster, const float position[3], const float n[3]);
 
 // Usable for the diffuse colour: lit, not grazing, not a highlight, not saturated, clean pixel.
 inline bool is_diffuse_sample(const Sample &s) {
@@ -67,6 +89,13 @@ struct GatherSettings {
   // choice). false: plain bilinear over all 4 texels, mixed or not (the RTI evaluation protocol:
   // held-out photos are compared as sampled, contamination included).
   bool own_surface_texels = true;
+  // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
+  // (pipeline.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
+  LobeForm lobe = LobeForm::PhongRE;
+  // Weight samples by their photo's resolution of the vertex (Sample::resolution); false: every
+  // code 0 (all photos alike). Off by default: on the spot pair the two-camera fit scored worse
+  // with it (README "The lobe's form and several cameras").
+  bool resolution_weights = false;
 };
 
 // Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
@@ -97,6 +126,11 @@ struct VisibilityMasks {
 VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
                                    const std::vector<LightSource> &lights,
                                    VisibilityBackend &backend, const ProgressFn &progress = {});
+
+// "Only on selection": clears the seen, lit and mixed bits of every vertex with vertex_mask[v] == 0,
+// so that no stage samples it (it reads as seen by no photo), and recounts seen_count. An empty
+// mask keeps every vertex. Throws InputError when the mask's size is not the vertex count.
+void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &vertex_mask);
 
 // Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`,
 // lit by `light` (its direction at the vertex: light_direction_at). The colour is the photo's,
@@ -129,6 +163,8 @@ struct GatherStats {
   double seconds = 0;
 };
 
+// Sample::resolution: for each vertex, photo_resolution of every sample's photo relative to the
+// best among the vertex's samples (resolution_code), when settings.resolution_weights.
 // Streams samples chunk by chunk (vertex ranges sized by settings.chunk_sample_bytes) to
 // `consume`. Chunks arrive in vertex order; the chunk object is reused after `consume` returns,
 // so `consume` may modify it (the fit corrects the samples' colours in place).

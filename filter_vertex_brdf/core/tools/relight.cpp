@@ -232,7 +232,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         r.mixed = (s.flags & kMixedPixel) != 0;
         r.modelled = has_model(fit);
         float predicted[3];
-        evaluate_phong(fit, s.n_dot_l, s.r_dot_e, predicted);
+        evaluate_phong(fit, s.n_dot_l, s.lobe_cos, predicted);
         const float irradiance = light_irradiance_at(lights[s.raster], mesh.positions + 3 * v);
         for (float &c : predicted) c *= irradiance;
         const uint8_t own = masks.own_texels(s.raster, v);

@@ -20,6 +20,10 @@ struct VisibilitySettings {
   // Resolution (square) of the light-view orthographic depth map over the mesh bounds.
   // 0 = automatic (resolved_shadow_map_size).
   int shadow_map_size = 0;
+  // GL back end: test the vertices against each depth map in a compute shader, where the map
+  // stays, and read back one byte per vertex (needs OpenGL 4.3). false, or a context without
+  // compute shaders: read the map back and test on the CPU. Both give the same codes.
+  bool depth_tests_on_gpu = true;
 };
 
 // The shadow-map resolution to use: `settings.shadow_map_size` when positive; for 0, the power of

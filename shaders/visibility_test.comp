@@ -1,0 +1,91 @@
+#version 430
+// Per-vertex tests against a depth map that stays on the GPU (visibility/visibility_gl.cpp): the
+// camera pass's code of each vertex (visibility.h: kCameraHidden, kCameraClear, or
+// kFootprintPartial | mask of own-surface footprint texels) or the light pass's lit (1) / cast
+// shadow (0). Four vertices per invocation, packed into one uint (byte k = vertex 4 i + k), so
+// that one byte per vertex comes back instead of the whole depth map.
+//
+// The lookups are those of visibility_gl.cpp's CPU path (depth_clear, footprint_code), which the
+// GL back end keeps for contexts without compute shaders; unit tests hold both paths against the
+// CPU ray caster. Camera pass: window coordinates come from the undistorted projection the depth
+// pass was rasterised with; a vertex outside that image or behind the camera is kCameraClear (the
+// frustum is not this pass's concern: samples.cpp tests it with the distorted projection).
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 0) readonly buffer Positions { float positions[]; };  // x y z per vertex, origin-relative
+layout(std430, binding = 1) writeonly buffer Codes { uint codes[]; };
+
+uniform uint u_vertex_count;
+uniform uint u_first_word;       // words (groups of 4 vertices) before this dispatch
+uniform int u_light_pass;        // 0: camera pass, 1: light pass
+uniform mat4 u_view;             // on origin-relative positions
+uniform mat4 u_projection;       // camera pass
+uniform int u_width, u_height;  // depth map size in texels
+uniform float u_tolerance;       // depth tolerance, world units
+uniform float u_slack_per_depth; // camera pass: own_surface_depth_slack = tolerance + this * depth
+uniform float u_light_scale;     // light pass: window mapping of light_view.h
+uniform int u_perspective;       // light pass: 1 for a point light (w = depth)
+uniform sampler2D u_depth;       // R32F linear depth, GL rows (row 0 = bottom of the image)
+
+ivec2 map_size() { return ivec2(u_width, u_height); }
+
+float texel(int x, int y) { return texelFetch(u_depth, ivec2(x, y), 0).r; }
+
+// depth is at most the tolerance behind the farthest of the 2x2 texels nearest to window point w.
+bool depth_clear(vec2 w, float depth) {
+  int i0 = int(floor(w.x - 0.5)), j0 = int(floor(w.y - 0.5));
+  int xa = clamp(i0, 0, map_size().x - 1), xb = clamp(i0 + 1, 0, map_size().x - 1);
+  int ya = clamp(j0, 0, map_size().y - 1), yb = clamp(j0 + 1, 0, map_size().y - 1);
+  float far_depth = max(max(texel(xa, ya), texel(xb, ya)), max(texel(xa, yb), texel(xb, yb)));
+  return depth <= far_depth + u_tolerance;
+}
+
+// The 2x2 bilinear footprint of image point img (pixels, y down): which texels show the vertex's
+// own surface.
+uint footprint_code(vec2 img, float depth) {
+  float allowed = u_tolerance + u_slack_per_depth * depth;
+  int x0 = int(floor(img.x - 0.5)), y0 = int(floor(img.y - 0.5));
+  uint mask = 0u;
+  for (int k = 0; k < 4; ++k) {
+    int i = x0 + k % 2, row = map_size().y - 1 - (y0 + k / 2);
+    if (i < 0 || row < 0 || i >= map_size().x || row >= map_size().y) continue;
+    if (abs(texel(i, row) - depth) <= allowed) mask |= 1u << uint(k);
+  }
+  return mask == 15u ? 1u : (16u | mask);
+}
+
+uint camera_code(vec3 p) {
+  vec4 view_pos = u_view * vec4(p, 1.0);
+  float depth = -view_pos.z;
+  vec4 clip = u_projection * view_pos;
+  if (!(clip.w > 0.0) || !(depth > 0.0)) return 1u;
+  vec2 w = (clip.xy / clip.w * 0.5 + 0.5) * vec2(map_size());
+  vec2 img = vec2(w.x, float(map_size().y) - w.y);
+  if (!(img.x >= 0.0 && img.x < float(map_size().x) && img.y >= 0.0 && img.y < float(map_size().y))) return 1u;
+  if (!depth_clear(w, depth)) return 0u;
+  return footprint_code(img, depth);
+}
+
+uint light_code(vec3 p) {
+  vec3 q = (u_view * vec4(p, 1.0)).xyz;
+  float depth = -q.z;
+  if (u_perspective != 0 && !(depth > 0.0)) return 1u;  // behind a point light: nothing in between
+  float w = u_perspective != 0 ? depth : 1.0;
+  vec2 win = (u_light_scale * q.xy / w + 1.0) * 0.5 * vec2(map_size());
+  return depth_clear(win, depth) ? 1u : 0u;
+}
+
+void main() {
+  uint word = u_first_word + gl_GlobalInvocationID.x;
+  uint first = 4u * word;
+  if (first >= u_vertex_count) return;
+  uint bytes = 0u;
+  for (uint k = 0u; k < 4u; ++k) {
+    uint v = first + k;
+    if (v >= u_vertex_count) break;
+    vec3 p = vec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+    uint code = u_light_pass != 0 ? light_code(p) : camera_code(p);
+    bytes |= code << (8u * k);
+  }
+  codes[word] = bytes;
+}
