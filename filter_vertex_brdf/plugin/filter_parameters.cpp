@@ -199,7 +199,8 @@ void read_gather(const RichParameterList &params, vbrdf::GatherSettings &gather)
   const float saturation = params.getFloat(kSaturationLevel);
   require(saturation > 0.0f && saturation <= 1.0f, kSaturationLevel, "must be in (0, 1]");
   const int budget = params.getInt(kMemoryBudgetMB);
-  require(budget >= 16, kMemoryBudgetMB, "must be at least 16");
+  require(budget >= 16, kMemoryBudgetMB,
+          "('Photo memory (MB)') must be at least 16: raise it (photos beyond it are decoded again when needed).");
   gather.specular_threshold = specular;
   gather.diffuse_threshold = diffuse;
   gather.encoding = photo_encoding(params);

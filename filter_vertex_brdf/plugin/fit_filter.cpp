@@ -15,6 +15,7 @@ namespace {
 // Parameter names of this filter only (the .mlx scripts refer to them, never rename); the shared
 // ones are in filter_parameters.h.
 const char *const kOutputPly = "outputPly";
+const char *const kOverwriteOutput = "overwriteOutput";
 const char *const kFitReflectance = "fitReflectance";
 const char *const kFitBackend = "fitBackend";
 const char *const kInitialShininess = "initialShininess";
@@ -69,6 +70,10 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
       "Where the mesh with the per-vertex results is written (binary PLY with float properties), with a "
       "report beside it (same name ending in _report.txt). Relative paths are relative to the "
       "project folder. Empty: the project's name followed by _brdf.ply, beside the project.");
+  params.addParam(RichBool(kOverwriteOutput, true, "Overwrite existing output",
+                           "On: an existing output PLY and report are replaced (atomically: the previous files "
+                           "stay intact until the new ones are complete) and the log says so. Off: the filter "
+                           "stops before any work when they exist. Input files are never overwritten."));
   shared::add_specular_threshold(params);
   shared::add_diffuse_threshold(params, shared::DiffuseThresholdUse::Fit);
   shared::add_photo_and_visibility(params);
@@ -116,6 +121,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.light_file = shared::light_file(params);
   shared::read_light_placement(params, s.dome_radius, s.light_unit_scale);
   s.output_ply = path(params, kOutputPly);
+  s.overwrite = params.getBool(kOverwriteOutput) ? vbrdf::OverwritePolicy::Replace : vbrdf::OverwritePolicy::Refuse;
   shared::read_gather(params, s.gather);
   shared::read_visibility(params, s.visibility_choice, s.visibility);
 
@@ -200,7 +206,8 @@ void FitFilter::apply(FilterRun &run) const {
           << " seen but without usable sample; " << result.fit_full << " full Phong fits, " << result.fit_diffuse_only
           << " diffuse-only (visibility: " << result.visibility_backend << ", fit: "
           << (result.fit_backend.empty() ? std::string("off") : result.fit_backend) << ", lights: " << result.light_file
-          << ", colour correction: " << color_summary(settings, result) << "). Wrote " << result.output_ply;
+          << ", colour correction: " << color_summary(settings, result) << "). Wrote " << result.output_ply << " ("
+          << result.output_note << ")";
   log(summary.str());
 }
 

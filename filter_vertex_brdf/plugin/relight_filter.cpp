@@ -221,8 +221,9 @@ void RelightFilter::initParameters(const MeshDocument &, RichParameterList &para
   shared::add_light_placement(params);
   params.addParam(RichString(kOutputFolder, "", "Output folder",
                              "Where the images, contact_sheet.png and relight_table.csv are written (created if "
-                             "needed; existing files of the same names are replaced). Relative paths are relative "
-                             "to the project folder. Empty: <project name>_relight beside the project."));
+                             "needed; existing files of the same names are replaced, and the log counts them). "
+                             "Relative paths are relative to the project folder. Empty: <project name>_relight "
+                             "beside the project."));
   params.addParam(RichBool(kRenderRasters, true, "Render every raster",
                            "Render each raster's camera under its light and compare with its photo."));
   params.addParam(RichBool(kNovelView, false, "Render a novel view",
@@ -280,16 +281,18 @@ void RelightFilter::apply(FilterRun &run) const {
     throw vbrdf::ProcessingError("relighting needs OpenGL 3.3, and MeshLab gave no usable OpenGL context.");
   vbrdf::RelightRenderer renderer(arrays.data.view(), fits, gl.get_proc(), s.render);
   std::vector<std::string> files;
+  size_t replaced = s.novel_view && vbrdf::file_exists(vbrdf::join_path(s.output_folder, "novel_view.png"));
   if (s.render_rasters) {
     const vbrdf::RelightReport report = vbrdf::relight_rasters(renderer, set.rasters, lights, s.output,
                                                                progress_adapter(run.progress, "Vertex BRDF: "));
     for (const std::string &line : report.color_log) log("Vertex BRDF relight, colour correction: " + line);
     log_report(report, log);
     files = report.files;
+    replaced += report.replaced;
   }
   if (s.novel_view) render_novel_view(renderer, set, arrays.data, s, files);
-  log("Vertex BRDF relight: wrote " + std::to_string(files.size()) + " files to " + s.output_folder +
-      " (OpenGL: " + renderer.renderer_name() + ").");
+  log("Vertex BRDF relight: wrote " + std::to_string(files.size()) + " files to " + s.output_folder + " (" +
+      std::to_string(replaced) + " replaced earlier files of the same names; OpenGL: " + renderer.renderer_name() + ").");
 }
 
 } // namespace vbrdf_plugin

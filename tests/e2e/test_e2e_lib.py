@@ -128,7 +128,7 @@ class ScriptTest(unittest.TestCase):
         params = {p.get("name"): p for p in root.find("filter").iter("Param")}
         self.assertEqual(root.find("filter").get("name"), "Vertex BRDF: fit per-vertex reflectance")
         types = {"lightFile": "RichString", "domeRadius": "RichFloat", "lightUnitScale": "RichFloat",
-                 "outputPly": "RichString", "specularThreshold": "RichFloat",
+                 "outputPly": "RichString", "overwriteOutput": "RichBool", "specularThreshold": "RichFloat",
                  "diffuseThreshold": "RichFloat", "photoEncoding": "RichEnum", "saturationLevel": "RichFloat",
                  "visibilityBackend": "RichEnum", "depthTolerance": "RichFloat", "shadowMapSize": "RichInt",
                  "memoryBudgetMB": "RichInt", "fitReflectance": "RichBool", "fitBackend": "RichEnum",

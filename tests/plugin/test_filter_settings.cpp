@@ -55,6 +55,7 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
   const vbrdf::FitSettings core;
   EXPECT_EQ(s.light_file, "");
   EXPECT_EQ(s.output_ply, "");
+  EXPECT_EQ(s.overwrite, core.overwrite);  // on: replaced, and logged
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, core.gather.specular_threshold);
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, vbrdf::kFitDiffuseThreshold);
   EXPECT_EQ(s.gather.encoding, core.gather.encoding);
@@ -81,6 +82,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("domeRadius", FloatValue(2.5f));
   p.setValue("lightUnitScale", FloatValue(10.0f));
   p.setValue("outputPly", StringValue("out.ply"));
+  p.setValue("overwriteOutput", BoolValue(false));
   p.setValue("specularThreshold", FloatValue(0.8f));
   p.setValue("diffuseThreshold", FloatValue(0.3f));
   p.setValue("photoEncoding", EnumValue(2));
@@ -105,6 +107,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_FLOAT_EQ(s.dome_radius, 2.5f);
   EXPECT_FLOAT_EQ(s.light_unit_scale, 10.0f);
   EXPECT_EQ(s.output_ply, "out.ply");
+  EXPECT_EQ(s.overwrite, vbrdf::OverwritePolicy::Refuse);
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, 0.8f);
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, 0.3f);
   EXPECT_EQ(s.gather.encoding, vbrdf::PhotoEncoding::Linear);

@@ -192,6 +192,10 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   check.mesh_name = input.mesh_name;
   check.rasters = input.rasters;
   validate_input(check);
+  if (settings_in.write_files && settings_in.overwrite == OverwritePolicy::Refuse)  // before any work
+    check_output_path(settings_in.suggestion_file.empty() ? default_suggestion_path(input.project_path)
+                                                          : settings_in.suggestion_file,
+                      settings_in.overwrite, "Suggestion file");
   const MeshView &mesh = input.mesh;
   const size_t n = mesh.vertex_count;
   if ((!input.dq.empty() && input.dq.size() != n) || (!input.sq.empty() && input.sq.size() != n) ||
@@ -313,7 +317,7 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   if (settings.write_files) write_coverage_files(settings, input, r, kv_text);
   std::istringstream lines(r.report);
   for (std::string line; std::getline(lines, line);) log(line);
-  if (!r.suggestion_file.empty()) log("suggestions written to " + r.suggestion_file);
+  if (!r.suggestion_file.empty()) log("suggestions written to " + r.suggestion_file + " (" + r.suggestion_note + ")");
   report_progress(progress, 1.0f, "done");
   return r;
 }

@@ -21,6 +21,7 @@
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
 #include "fit/pipeline.h"
+#include "io/output_file.h"
 #include "samples/samples.h"
 #include "calibration/sphere_lights.h"
 #include "inputs/viewpoints.h"
@@ -58,6 +59,9 @@ struct CoverageSettings {
   float dome_radius = 0;            // as FitSettings: the .lp's directions as point lights on a dome
   float light_unit_scale = 0;       // as FitSettings: mesh units per unit of the light file's positions
   std::string suggestion_file;      // "" = <project folder>/<project name>_next_light.txt
+  // An existing suggestion file (and its vertex list): replaced, the log saying so (the default:
+  // each run replaces the last one and learns from it), or the run refused before any work.
+  OverwritePolicy overwrite = OverwritePolicy::Replace;
   bool write_files = true;          // false: nothing is written (result only)
 };
 
@@ -109,6 +113,7 @@ struct CoverageResult {
   size_t view_hint_vertices = 0;           // new-view vertices facing it (N.D >= 0.5)
   std::string light_file;                  // the .lp used
   std::string suggestion_file, vertex_list_file;  // written files ("" when not written)
+  std::string suggestion_note;             // "new file" / "replaces the existing file (N bytes)"
   std::string report;                      // human-readable (also in the suggestion file)
   std::string visibility_backend;
   double seconds_visibility = 0, seconds_gather = 0, seconds_suggest = 0;

@@ -15,7 +15,8 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
   if (choice != VisibilityChoice::CPU) {
     if (!get_proc) {
       if (choice == VisibilityChoice::GL)
-        throw ProcessingError("The OpenGL visibility back end was requested but no GL context is available.");
+        throw ProcessingError("'Visibility' is set to GPU (OpenGL), but no GL context is available: set 'Visibility' "
+                              "to Auto or CPU (ray cast).");
       log("Visibility: no GL context, using the CPU ray caster.");
     } else {
       try {
@@ -23,7 +24,9 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
         log(std::string("Visibility: ") + gl->name() + ".");
         return gl;
       } catch (const ProcessingError &e) {
-        if (choice == VisibilityChoice::GL) throw;
+        if (choice == VisibilityChoice::GL)
+          throw ProcessingError(std::string("'Visibility' is set to GPU (OpenGL), but ") + e.what() +
+                                " Set 'Visibility' to Auto or CPU (ray cast).");
         log(std::string("Visibility: GL depth passes unavailable (") + e.what() + "); using the CPU ray caster.");
       }
     }
@@ -89,11 +92,14 @@ std::unique_ptr<PhongFitter> make_phong_fitter(FitBackendChoice choice, const Ge
         log(std::string("Phong fit: ") + gpu->name() + ".");
         return std::unique_ptr<PhongFitter>(gpu.release());
       } catch (const ProcessingError &e) {
-        if (choice == FitBackendChoice::GPU) throw;
+        if (choice == FitBackendChoice::GPU)
+          throw ProcessingError(std::string("'Fit back end' is set to GPU (compute shader), but ") + e.what() +
+                                " Set 'Fit back end' to Auto or CPU (reference).");
         log(std::string("Phong fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");
       }
     } else if (choice == FitBackendChoice::GPU) {
-      throw ProcessingError("The GPU fit back end was requested but no GL context is available.");
+      throw ProcessingError("'Fit back end' is set to GPU (compute shader), but no GL context is available: set "
+                            "'Fit back end' to Auto or CPU (reference).");
     }
   }
   std::unique_ptr<PhongFitter> cpu(new CpuFitter());

@@ -7,6 +7,8 @@
 
 #include "base/errors.h"
 #include "base/file_util.h"
+#include "inputs/mesh_file.h"
+#include "inputs/photo_content.h"
 #include "base/vec3.h"
 #include "calibration/color_plan.h"
 #include "inputs/light_file.h"
@@ -35,6 +37,10 @@ void validate_input(const FitInput &input) {
     if (!shot_is_valid(raster.shot))
       throw InputError("Raster " + std::to_string(r) + " ('" + raster.label +
                        "') has no valid camera: register it to the mesh first.");
+    if (shot_is_identity(raster.shot))
+      throw InputError("Raster " + std::to_string(r) + " ('" + raster.label +
+                       "') has an identity camera (at the world origin, looking along -z): it was not registered. "
+                       "Register it to the mesh first, or remove the raster.");
     if (!file_exists(raster.image_path))
       throw InputError("Raster " + std::to_string(r) + " ('" + raster.label + "'): photo '" + raster.image_path +
                        "' is missing. Restore the file or fix the path in the project.");
@@ -164,6 +170,11 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
     if (!protected_path.empty() && result.output_ply == protected_path)
       throw InputError("The output '" + result.output_ply + "' would overwrite an input file: choose another 'outputPly'.");
 
+  check_output_path(report_path_for(result.output_ply), settings.overwrite, "Output PLY");
+  result.output_note = check_output_path(result.output_ply, settings.overwrite, "Output PLY");
+  result.normals_source = describe_normals_source(input.mesh_path);
+  log(result.normals_source + ".");
+
   // The photos decode in the background while the GL passes run (photo_prefetch.h); a photo that
   // cannot be decoded fails before any sample is gathered, so before anything is written.
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
@@ -181,6 +192,34 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   restrict_to_vertices(masks, input.vertex_mask);
   result.seconds_visibility = seconds_since(t);
   prefetch->finish();
+  // Every photo's content (photo_content.h), before any sample is gathered: mostly from the cache.
+  std::vector<PhotoContent> contents;
+  size_t largest_photo = 0;
+  for (const Raster &r : input.rasters) {
+    const auto photo = photos.get(r.image_path, r.width(), r.height());
+    contents.push_back(analyse_photo(*photo));
+    largest_photo = std::max(largest_photo, photo->pixels.total() * photo->pixels.elemSize());
+  }
+  if (largest_photo > settings.gather.photo_cache_bytes) {
+    result.memory_note = "photo memory: a decoded photo needs " + std::to_string((largest_photo >> 20) + 1) +
+                         " MB, more than 'Photo memory (MB)' (" + std::to_string(settings.gather.photo_cache_bytes >> 20) +
+                         " MB): photos are kept one at a time and decoded again for each vertex chunk (slower); "
+                         "raise 'Photo memory (MB)' to keep them";
+    log("Vertex BRDF: " + result.memory_note + ".");
+  }
+  result.warnings = check_photo_contents(input.rasters, contents);
+  for (const std::string &w : result.warnings) log(w);
+  if (std::all_of(masks.seen_count.begin(), masks.seen_count.end(), [](uint32_t c) { return c == 0; }))
+    throw InputError("No raster's camera sees the mesh (every vertex is outside every photo, behind its camera or "
+                     "back-facing): the registration does not match this mesh. Check that the project's rasters "
+                     "were registered to it. Nothing was written.");
+  for (size_t i = 0; i < input.rasters.size(); ++i)
+    if (masks.seen_count[i] == 0) {
+      result.warnings.push_back("WARNING: raster '" + input.rasters[i].label +
+                                "' sees no vertex of the mesh (its camera points elsewhere: check its registration); "
+                                "the other photos were used without it.");
+      log(result.warnings.back());
+    }
 
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
@@ -209,11 +248,26 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
 
   t = Clock::now();
   build_outputs(input, settings, result);
+  if (result.vertices_coloured == 0) {
+    result.warnings.push_back("WARNING: no vertex got a colour or a model: every sample was shadowed, saturated or "
+                              "unusable (see the counts below).");
+    log(result.warnings.back());
+  }
   result.report = build_report(input, settings, result);
-  write_result_ply(result.output_ply, mesh, result.colors_rgba, result.attributes);
-  result.seconds_output = seconds_since(t);
-  result.report += "output: " + result.output_ply + " (written in " + fixed(result.seconds_output) + " s)\n";
-  write_text_file_atomically(report_path_for(result.output_ply), result.report);
+  {
+    // PLY and report are committed together: a concurrent run writing the same files waits here.
+    OutputFolderLock lock(directory_of(result.output_ply));
+    if (settings.overwrite == OverwritePolicy::Refuse)  // again: another run may have written it meanwhile
+      check_output_path(result.output_ply, settings.overwrite, "Output PLY");
+    AtomicOutput ply(result.output_ply), report(report_path_for(result.output_ply));
+    stage_result_ply(ply, mesh, result.colors_rgba, result.attributes);
+    result.seconds_output = seconds_since(t);
+    result.report += "output: " + result.output_ply + " (" + result.output_note + "; written in " +
+                     fixed(result.seconds_output) + " s)\n";
+    stage_text_file(report, result.report);
+    ply.commit();
+    report.commit((long long)result.report.size());
+  }
 
   std::istringstream lines(result.report);
   for (std::string line; std::getline(lines, line);) log(line);

@@ -17,6 +17,7 @@
 #include "fit/phong_fit.h"
 #include "fit/materials.h"
 #include "base/mesh_view.h"
+#include "io/output_file.h"
 #include "io/output_ply.h"
 #include "samples/samples.h"
 #include "inputs/viewpoints.h"
@@ -60,6 +61,10 @@ struct FitSettings {
   float dome_radius = 0;     // > 0: the .lp's directions are point lights this far from the mesh's centre
   float light_unit_scale = 0;  // mesh units per unit of the light file's positions (0: .json 1, .dome required)
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
+  // An existing output PLY / report: replaced (and the log says so) or the run refused before any
+  // work (io/output_file.h). Replace by default: re-running a script into the same file is the
+  // normal loop, and the inputs themselves can never be outputs.
+  OverwritePolicy overwrite = OverwritePolicy::Replace;
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
   // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.
   int fill_unseen_rings = 0;
@@ -111,12 +116,17 @@ struct FitResult {
   size_t color_viewpoints_corrected = 0;
   std::string output_ply;                 // where the PLY was written
   std::string report;                     // human-readable report (also written beside the PLY)
+  std::vector<std::string> warnings;      // "WARNING: ..." lines: first in the report, logged when found
+  std::string normals_source;             // where the normals come from (inputs/mesh_file.h)
+  std::string output_note;                // "new file" / "replaces the existing file (N bytes)"
+  std::string memory_note;                // a photo larger than the photo memory: how it was handled
   size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;
   double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
 };
 
 // Runs the pipeline and writes the PLY and the report (<ply stem>_report.txt). Nothing is
-// written if any stage fails. `fitter` may be null when settings.fit_reflectance is false.
+// written if any stage fails; the two files are committed together under a lock on their folder
+// (io/output_file.h), so concurrent runs leave one run's complete pair. `fitter` may be null when settings.fit_reflectance is false.
 // Throws InputError / ProcessingError.
 FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
                   PhongFitter *fitter, const ProgressFn &progress, const LogFn &log);

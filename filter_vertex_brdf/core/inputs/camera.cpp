@@ -46,6 +46,17 @@ bool shot_is_valid(const Shot &shot) {
   return true;
 }
 
+bool shot_is_identity(const Shot &shot) {
+  const vcg::Matrix44f r = rotation(shot);
+  const vcg::Point3f t = shot.Extrinsics.Tra();
+  for (int i = 0; i < 3; ++i) {
+    if (t[i] != 0.0f) return false;
+    for (int j = 0; j < 3; ++j)
+      if (r[i][j] != (i == j ? 1.0f : 0.0f)) return false;
+  }
+  return true;
+}
+
 ImagePoint project_to_image(const Shot &shot, const float world[3]) {
   const vcg::Point3f p(world[0], world[1], world[2]);
   ImagePoint ip;

@@ -26,6 +26,11 @@ struct Raster {
 // True when the shot can project: positive focal length, pixel size and viewport, finite values.
 bool shot_is_valid(const Shot &shot);
 
+// True when the shot's pose is exactly the identity (at the world origin, axes along the world's):
+// the pose of a raster that was never registered (a .mlp written by hand or by a tool that had
+// no registration); a registration never lands there exactly.
+bool shot_is_identity(const Shot &shot);
+
 // True when two shots are one registration (photos of one viewpoint): equal viewport, and focal
 // length, pixel size, principal point, radial distortion, rotation and translation equal to 1e-6
 // relative (absolute below magnitude 1). Symmetric; false when any value is NaN.

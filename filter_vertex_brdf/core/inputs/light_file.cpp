@@ -33,6 +33,7 @@ std::vector<LightEntry> read_light_file(const std::string &path) {
   long count = -1;
   while (count < 0 && std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (is_blank(line)) continue;
     std::istringstream ls(line);
     if (!(ls >> count) || count <= 0) fail(path, line_no, "the first line must be the number of lights");
@@ -40,6 +41,7 @@ std::vector<LightEntry> read_light_file(const std::string &path) {
   if (count < 0) fail(path, line_no, "the file is empty");
 
   std::vector<LightEntry> lights;
+  std::vector<int> lines;  // line number of each entry
   while (std::getline(in, line)) {
     ++line_no;
     if (is_blank(line)) continue;
@@ -68,7 +70,16 @@ std::vector<LightEntry> read_light_file(const std::string &path) {
     const float len = std::sqrt(e.dir_cam[0] * e.dir_cam[0] + e.dir_cam[1] * e.dir_cam[1] + e.dir_cam[2] * e.dir_cam[2]);
     if (!(len > 1e-6f)) fail(path, line_no, "the light direction has zero length");
     for (float &c : e.dir_cam) c /= len;
+    for (size_t i = 0; i < lights.size(); ++i) {
+      if (lights[i].image != e.image) continue;
+      const float dot = lights[i].dir_cam[0] * e.dir_cam[0] + lights[i].dir_cam[1] * e.dir_cam[1] +
+                        lights[i].dir_cam[2] * e.dir_cam[2];
+      if (dot < 0.99999f)
+        fail(path, line_no, "photo '" + e.image + "' is listed again (first on line " + std::to_string(lines[i]) +
+                                ") with another direction; keep the one line that belongs to it");
+    }
     lights.push_back(e);
+    lines.push_back(line_no);
   }
   if (long(lights.size()) != count)
     fail(path, line_no, "the first line says " + std::to_string(count) + " lights but " +

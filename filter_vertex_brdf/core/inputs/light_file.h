@@ -17,7 +17,9 @@ struct LightEntry {
 };
 
 // Reads an .lp file. Throws InputError naming the file and line on: unreadable file, bad count,
-// fewer/more lines than the count says, non-numeric values, zero-length direction.
+// fewer/more lines than the count says, non-numeric values, zero-length direction, one image
+// listed twice with different directions (twice with the same one is accepted). A UTF-8
+// byte-order mark and CRLF line ends are accepted.
 std::vector<LightEntry> read_light_file(const std::string &path);
 
 // Writes an .lp file (RTIBuilder/Relight compatible), atomically. Throws ProcessingError on I/O.

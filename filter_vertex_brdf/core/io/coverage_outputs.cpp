@@ -200,6 +200,8 @@ void write_coverage_files(const CoverageSettings &settings, const CoverageInput 
   if (r.suggestion_file == input.project_path || r.suggestion_file == r.light_file)
     throw InputError("The suggestion file '" + r.suggestion_file + "' would overwrite an input file: choose another.");
   r.vertex_list_file = strip_extension(r.suggestion_file) + "_new_view_vertices.txt";
+  check_output_path(r.vertex_list_file, settings.overwrite, "Suggestion file");
+  r.suggestion_note = check_output_path(r.suggestion_file, settings.overwrite, "Suggestion file");
   std::ostringstream list;
   list << "# Vertices (0-based, mesh order) only a new viewpoint can cover: index reason\n"
        << "# reason: unseen = no photo sees it; diffuse / specular = no placeable light of a registered "

@@ -132,9 +132,12 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   const size_t n = mesh.vertex_count;
   const GatherStats &g = r.gather;
   std::ostringstream rep;
-  rep << "filter_vertex_brdf report\n"
-      << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
+  rep << "filter_vertex_brdf report\n";
+  for (const std::string &w : r.warnings) rep << w << "\n";
+  rep << "mesh: " << input.mesh_name << " (" << n << " vertices, " << mesh.index_count / 3 << " triangles)\n"
       << only_on_selection(input)
+      << r.normals_source << "\n"
+      << (r.memory_note.empty() ? std::string() : r.memory_note + "\n")
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
       << "lights against the photos (predicted irradiance vs brightness): "
       << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
@@ -157,9 +160,6 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   for (const auto &f : flag_names)
     rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
   rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
-  for (size_t i = 0; i < input.rasters.size(); ++i)
-    if (g.raster_seen_vertices[i] == 0)
-      rep << "skipped: raster '" << input.rasters[i].label << "' sees no vertex (check its registration); its photo was not read\n";
   if (settings.fit_reflectance)
     rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
         << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)

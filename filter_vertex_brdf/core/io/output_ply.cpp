@@ -3,13 +3,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <unistd.h>
+#include <sys/stat.h>
 
 #include <vcg/complex/complex.h>
 #include <wrap/io_trimesh/export_ply.h>
 
 #include "base/errors.h"
+#include "base/file_util.h"
 
 namespace vbrdf {
 
@@ -36,19 +36,22 @@ void add_float_property(vcg::tri::io::PlyInfo &info, const std::string &name) {
   d.memtype1 = vcg::ply::T_FLOAT;
 }
 
-std::string temporary_path_for(const std::string &path) {
-  return path + ".tmp" + std::to_string(::getpid());
-}
-
-void commit_temporary(const std::string &tmp, const std::string &path) {
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw ProcessingError("Cannot move the result into place at '" + path + "': check that the folder is writable.");
-  }
+// Bytes of the binary PLY written for `vertices`, `faces` and `attributes` float properties:
+// its header (read back from the file) plus the records.
+long long expected_ply_bytes(const std::string &file, size_t vertices, size_t faces, size_t attributes) {
+  std::FILE *f = std::fopen(file.c_str(), "rb");
+  if (!f) return -1;
+  std::string head(65536, '\0');
+  head.resize(std::fread(&head[0], 1, head.size(), f));
+  std::fclose(f);
+  const size_t end = head.find("end_header\n");
+  if (end == std::string::npos) return -1;
+  const long long vertex_bytes = 12 + 12 + 4 + 4 * (long long)attributes, face_bytes = 1 + 12;
+  return (long long)(end + 11) + (long long)vertices * vertex_bytes + (long long)faces * face_bytes;
 }
 } // namespace
 
-void write_result_ply(const std::string &path, const MeshView &mesh, const std::vector<uint8_t> &colors_rgba,
+void stage_result_ply(AtomicOutput &out, const MeshView &mesh, const std::vector<uint8_t> &colors_rgba,
                       const std::vector<VertexAttribute> &attributes) {
   if (colors_rgba.size() != 4 * mesh.vertex_count)
     throw ProcessingError("internal: colour array size does not match the mesh");
@@ -81,27 +84,45 @@ void write_result_ply(const std::string &path, const MeshView &mesh, const std::
     add_float_property(info, a.name);
   }
 
-  const std::string tmp = temporary_path_for(path);
-  const int err = vcg::tri::io::ExporterPLY<OutMesh>::Save(m, tmp.c_str(), true, info);
-  if (err != 0) {
-    std::remove(tmp.c_str());
-    throw ProcessingError("Cannot write '" + path + "': " + vcg::tri::io::ExporterPLY<OutMesh>::ErrorMsg(err) +
-                          ". Check that the folder exists and is writable.");
+  const int err = vcg::tri::io::ExporterPLY<OutMesh>::Save(m, out.temporary().c_str(), true, info);
+  // vcglib does not check its writes: a short file (disk full, file size limit) is found here.
+  const long long expected = expected_ply_bytes(out.temporary(), mesh.vertex_count, mesh.index_count / 3, attributes.size());
+  struct stat st;
+  const bool complete = ::stat(out.temporary().c_str(), &st) == 0 && (long long)st.st_size == expected;
+  if (err != 0 || !complete) {
+    const std::string cause = err != 0 && expected < 0 && !file_exists(out.temporary())
+                                  ? std::string(vcg::tri::io::ExporterPLY<OutMesh>::ErrorMsg(err)) + " (" +
+                                        out.failure_cause() + ")"
+                                  : out.failure_cause();
+    std::remove(out.temporary().c_str());
+    throw ProcessingError("Cannot write '" + out.path() + "': " + cause + ". Free space or choose another file; " +
+                          (file_exists(out.path()) ? "the previous file is unchanged." : "nothing was written."));
   }
-  commit_temporary(tmp, path);
+}
+
+void write_result_ply(const std::string &path, const MeshView &mesh, const std::vector<uint8_t> &colors_rgba,
+                      const std::vector<VertexAttribute> &attributes) {
+  AtomicOutput out(path);
+  stage_result_ply(out, mesh, colors_rgba, attributes);
+  out.commit();
+}
+
+void stage_text_file(AtomicOutput &out, const std::string &text) {
+  std::FILE *f = std::fopen(out.temporary().c_str(), "wb");
+  const bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  const bool closed = f && std::fclose(f) == 0;
+  if (!ok || !closed) {
+    const std::string cause = out.failure_cause();
+    std::remove(out.temporary().c_str());
+    throw ProcessingError("Cannot write '" + out.path() + "': " + cause + ". Free space or choose another folder; " +
+                          (file_exists(out.path()) ? "the previous file is unchanged." : "nothing was written."));
+  }
 }
 
 void write_text_file_atomically(const std::string &path, const std::string &text) {
-  const std::string tmp = temporary_path_for(path);
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out.flush()) {
-      std::remove(tmp.c_str());
-      throw ProcessingError("Cannot write '" + path + "': check that the folder exists and is writable.");
-    }
-  }
-  commit_temporary(tmp, path);
+  AtomicOutput out(path);
+  stage_text_file(out, text);
+  out.commit((long long)text.size());
 }
 
 } // namespace vbrdf

@@ -155,6 +155,8 @@ RelightReport relight_rasters(RelightRenderer &renderer, const std::vector<Raste
     ensure_folder(options.folder);
   }
   RelightReport report;
+  for (const std::string &p : paths)
+    report.replaced += check_output_path(p, options.overwrite, "Output folder") != "new file";
   const ColorPlan colors = plan_colors(rasters, light_directions(lights), options, report.color_log);
   std::vector<cv::Mat> panels;
   for (size_t r = 0; r < rasters.size(); ++r) {

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "io/output_file.h"
 #include "calibration/color_plan.h"
 #include "inputs/light_source.h"
 #include "inputs/photo.h"
@@ -39,12 +40,16 @@ struct RelightOutputOptions {
   ColorCorrectionChoice color_correction = ColorCorrectionChoice::Auto;  // color_plan.h, as the fit's
   std::vector<float> chart_corners;  // as FitSettings::chart_corners: empty, 8, or 8 per viewpoint
   ExposureMode exposure = ExposureMode::Auto;
+  // Existing files of the same names in `folder`: replaced (counted in RelightReport::replaced)
+  // or the run refused before any rendering.
+  OverwritePolicy overwrite = OverwritePolicy::Replace;
 };
 
 struct RelightReport {
   std::vector<RelightRow> rows;   // one per raster, in order
   RelightRow overall;             // pooled over every raster
   std::vector<std::string> files; // written files (images, contact sheet, table)
+  size_t replaced = 0;            // of them, files that replaced an earlier one
   std::vector<std::string> color_log;  // per viewpoint: chart found / correction used
 };
 
