@@ -76,6 +76,7 @@ const char *const kColorCorrection = "colorCorrection";
 const char *const kChartCorners = "chartCorners";
 const char *const kExposureNormalisation = "exposureNormalisation";
 const char *const kOnlySelected = "onlySelectedVertices";
+const char *const kQualityOutput = "qualityOutput";
 
 namespace {
 
@@ -232,6 +233,20 @@ int min_specular_samples(const RichParameterList &params) {
   const int n = params.getInt(kMinSpecularSamples);
   require(n >= 1 && n <= 1000, kMinSpecularSamples, "must be in [1, 1000]");
   return n;
+}
+
+// --- Vertex quality -----------------------------------------------------------------------------
+
+void add_quality_output(RichParameterList &params) {
+  params.addParam(RichEnum(kQualityOutput, int(vbrdf::QualityOutput::DQ),
+                           QStringList() << "Diffuse quality (DQ)" << "Specular quality (SQ)" << "Fit RMSE",
+                           "Vertex quality",
+                           "What goes into vertex quality: DQ or SQ (0..2, higher is better) or the fit RMSE (lower "
+                           "is better). Vertices without a model get the median of the others."));
+}
+
+vbrdf::QualityOutput quality_output(const RichParameterList &params) {
+  return vbrdf::QualityOutput(enum_value(params, kQualityOutput, 3, "0 (DQ), 1 (SQ) or 2 (RMSE)"));
 }
 
 // --- Only on selection --------------------------------------------------------------------------

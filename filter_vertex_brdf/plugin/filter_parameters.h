@@ -121,6 +121,11 @@ int shadow_map_size(const RichParameterList &params);
 void add_min_specular_samples(RichParameterList &params);
 int min_specular_samples(const RichParameterList &params);  // in [1, 1000]
 
+// --- Vertex quality (fit, load result attributes) ----------------------------------------------
+extern const char *const kQualityOutput;  // "qualityOutput"
+void add_quality_output(RichParameterList &params);
+vbrdf::QualityOutput quality_output(const RichParameterList &params);
+
 // --- Only on selection (fit, coverage) ----------------------------------------------------------
 extern const char *const kOnlySelected;  // "onlySelectedVertices", labelled as MeshLab's colour projection
 void add_only_selected(RichParameterList &params);

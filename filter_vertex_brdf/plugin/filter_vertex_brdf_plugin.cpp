@@ -4,26 +4,12 @@
 #include <string>
 
 #include "core/base/errors.h"
-#include "coverage_filter.h"
 #include "filter_parameters.h"
-#include "fit_filter.h"
-#include "import_photos_filter.h"
-#include "load_result_filter.h"
-#include "relight_filter.h"
-#include "show_colors_filter.h"
-#include "sphere_filter.h"
+#include "plugin_filters.h"
 
 using vbrdf_plugin::PluginFilter;
 
-FilterVertexBrdfPlugin::FilterVertexBrdfPlugin() {
-  // Order = FilterIDType: append new filters at the end.
-  filters_.emplace_back(new vbrdf_plugin::FitFilter());
-  filters_.emplace_back(new vbrdf_plugin::RelightFilter());
-  filters_.emplace_back(new vbrdf_plugin::SphereFilter());
-  filters_.emplace_back(new vbrdf_plugin::CoverageFilter());
-  filters_.emplace_back(new vbrdf_plugin::ImportPhotosFilter());
-  filters_.emplace_back(new vbrdf_plugin::LoadResultFilter());
-  filters_.emplace_back(new vbrdf_plugin::ShowColorsFilter());
+FilterVertexBrdfPlugin::FilterVertexBrdfPlugin() : filters_(vbrdf_plugin::make_plugin_filters()) {
 
   for (size_t id = 0; id < filters_.size(); ++id) {
     typeList << FilterIDType(id);

@@ -22,7 +22,6 @@ const char *const kInitialShininess = "initialShininess";
 const char *const kSpecularLobe = "specularLobe";
 const char *const kMaxIterations = "maxIterations";
 const char *const kFillUnseenRings = "fillUnseenRings";
-const char *const kQualityOutput = "qualityOutput";
 
 std::string color_summary(const vbrdf::FitSettings &settings, const vbrdf::FitResult &result) {
   if (settings.color_correction == vbrdf::ColorCorrectionChoice::Off) return "off";
@@ -106,12 +105,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                           "those within N edges of a modelled vertex take their neighbours' parameters "
                           "(fit_status 3, like seen vertices without a usable sample, which are always filled). "
                           "0 = off."));
-  params.addParam(RichEnum(kQualityOutput, 0, QStringList() << "Diffuse quality (DQ)" << "Specular quality (SQ)"
-                                                             << "Fit RMSE",
-                           "Vertex quality",
-                           "What is stored in vertex quality, for Render > Color > Per Vertex Quality: the "
-                           "thesis's diffuse or specular quality (0..2, higher is better) or the weighted "
-                           "fit RMSE (lower is better)."));
+  shared::add_quality_output(params);
   shared::add_color_correction(params);
   shared::add_only_selected(params);
 }
@@ -135,8 +129,6 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(fill_rings >= 0 && fill_rings <= 1000, kFillUnseenRings, "must be in [0, 1000]");
   const int lobe = params.getEnum(kSpecularLobe);
   require(lobe >= 0 && lobe <= 1, kSpecularLobe, "must be 0 (Phong on R.E) or 1 (Blinn-Phong on N.H)");
-  const int quality = params.getEnum(kQualityOutput);
-  require(quality >= 0 && quality <= 2, kQualityOutput, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
 
   s.fit_reflectance = params.getBool(kFitReflectance);
   s.fit_backend = vbrdf::FitBackendChoice(fit_backend);
@@ -145,7 +137,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.phong.lobe = vbrdf::LobeForm(lobe);
   s.phong.min_specular_samples = shared::min_specular_samples(params);
   s.fill_unseen_rings = fill_rings;
-  s.quality = vbrdf::QualityOutput(quality);
+  s.quality = shared::quality_output(params);
   s.color_correction = shared::color_correction(params);
   s.chart_corners = shared::chart_corners(params);
   s.exposure = shared::exposure_normalisation(params);

@@ -14,7 +14,6 @@ namespace {
 
 // Parameter names (the .mlx scripts refer to them, never rename).
 const char *const kResultPly = "resultPly";
-const char *const kQuality = "qualityOutput";  // as the fit's
 const char *const kShowColors = "showResultColors";
 
 } // namespace
@@ -48,10 +47,7 @@ void LoadResultFilter::initParameters(const MeshDocument &, RichParameterList &p
   add_path(params, kResultPly, "Result PLY",
            "The PLY the fit wrote for this mesh (by default <project>_brdf.ply beside the project). Empty: that "
            "default file.");
-  params.addParam(RichEnum(kQuality, 0, QStringList() << "Diffuse quality (DQ)" << "Specular quality (SQ)" << "Fit RMSE",
-                           "Vertex quality",
-                           "What goes into vertex quality: DQ or SQ (0..2, higher is better) or the fit RMSE (lower "
-                           "is better). Vertices without a model get the median of the others."));
+  shared::add_quality_output(params);
   params.addParam(RichBool(kShowColors, true, "Show the result's colours",
                            "Vertex colours become the result's (the fitted albedo); they are also kept as the fit's "
                            "colours for 'Vertex BRDF: show vertex colours'. Off: only the attributes and quality."));
@@ -60,8 +56,7 @@ void LoadResultFilter::initParameters(const MeshDocument &, RichParameterList &p
 void LoadResultFilter::apply(FilterRun &run) const {
   MeshModel *mesh = run.document.mm();
   if (mesh == nullptr) throw vbrdf::InputError("No current mesh: open the mesh the result was fitted on first.");
-  const int quality = run.params.getEnum(kQuality);
-  require(quality >= 0 && quality <= 2, kQuality, "must be 0 (DQ), 1 (SQ) or 2 (RMSE)");
+  const vbrdf::QualityOutput quality = shared::quality_output(run.params);
   const MeshArrays arrays = mesh_arrays(*mesh);
   const std::string project = project_path(run.document, *mesh);
   std::string file = resolve_path(path(run.params, kResultPly), project);
@@ -69,7 +64,7 @@ void LoadResultFilter::apply(FilterRun &run) const {
 
   const vbrdf::ResultPly result = vbrdf::read_result_ply(file);
   const vbrdf::AttachedResult attached =
-      vbrdf::attach_result(result, arrays.data.view(), utf8(mesh->label()), file, vbrdf::QualityOutput(quality));
+      vbrdf::attach_result(result, arrays.data.view(), utf8(mesh->label()), file, quality);
   StoredResults stored;
   stored.layer = ColorLayer::Fit;
   stored.colors_rgba = attached.colors_rgba;
@@ -86,8 +81,9 @@ void LoadResultFilter::apply(FilterRun &run) const {
   if (attached.quality.empty())
     log << " No Phong model in the file ('" << attached.missing_model_attribute << "' missing): quality unchanged.";
   else
-    log << " Quality: " << (quality == 1 ? "SQ" : quality == 2 ? "fit RMSE" : "DQ") << "; " << attached.modelled
-        << " vertices have a model, the others got the median.";
+    log << " Quality: "
+        << (quality == vbrdf::QualityOutput::SQ ? "SQ" : quality == vbrdf::QualityOutput::RMSE ? "fit RMSE" : "DQ")
+        << "; " << attached.modelled << " vertices have a model, the others got the median.";
   run.log(GLLogStream::FILTER, log.str());
 }
 

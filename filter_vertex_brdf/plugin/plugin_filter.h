@@ -1,8 +1,8 @@
 #pragma once
 // One filter of the plugin. The plugin class (filter_vertex_brdf_plugin.h) only registers the
 // filters and dispatches to them; each filter lives in its own small file and implements this.
-// Adding a filter: write a class derived from PluginFilter and append it in the plugin's
-// constructor.
+// Adding a filter: write a class derived from PluginFilter and append it in make_plugin_filters
+// (plugin_filters.h).
 #include <functional>
 #include <string>
 

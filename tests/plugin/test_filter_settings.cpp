@@ -16,6 +16,7 @@
 #include "fit_filter.h"
 #include "import_photos_filter.h"
 #include "meshlab_bridge.h"
+#include "plugin_filters.h"
 #include "relight_filter.h"
 #include "sphere_filter.h"
 
@@ -400,20 +401,13 @@ TEST(ImportSettingsFrom, PhotoListSphereModeAndChecks) {
 // --- One declaration per shared parameter ----------------------------------------------------------
 
 TEST(SharedParameters, EveryFilterDeclaresASharedNameIdentically) {
-  const FitFilter fit;
-  const CoverageFilter coverage;
-  const RelightFilter relight;
-  const SphereFilter sphere;
-  const ImportPhotosFilter import;
-  const std::vector<std::pair<const char *, const PluginFilter *>> filters = {
-      {"fit", &fit}, {"coverage", &coverage}, {"relight", &relight}, {"sphere", &sphere}, {"import", &import}};
   // name -> (filter, declaration)
   std::map<std::string, std::vector<std::pair<std::string, std::string>>> seen;
   std::map<std::string, std::vector<std::string>> types_and_labels;
-  for (const auto &f : filters) {
-    const RichParameterList params = defaults_of(*f.second);
+  for (const auto &f : make_plugin_filters()) {
+    const RichParameterList params = defaults_of(*f);
     for (const RichParameter &p : params) {
-      seen[utf8(p.name())].push_back({f.first, declaration(p)});
+      seen[utf8(p.name())].push_back({utf8(f->name()), declaration(p)});
       types_and_labels[utf8(p.name())].push_back(utf8(p.stringType() + " " + p.fieldDescription()));
     }
   }
@@ -424,7 +418,8 @@ TEST(SharedParameters, EveryFilterDeclaresASharedNameIdentically) {
       shared::kMinSpecularSamples, shared::kViewpointRaster,  shared::kSphereCenterX,
       shared::kSphereCenterY,     shared::kSphereRadius,      shared::kOutputLightFile,
       shared::kColorCorrection,   shared::kChartCorners,      shared::kExposureNormalisation,
-      shared::kDomeRadius,        shared::kLightUnitScale,   shared::kOnlySelected};
+      shared::kDomeRadius,        shared::kLightUnitScale,   shared::kOnlySelected,
+      shared::kQualityOutput};
   // Their default (and the tooltip's last words) differ on purpose: filter_parameters.h says why.
   const std::set<std::string> deliberate = {shared::kDiffuseThreshold, shared::kOutputLightFile};
   for (const auto &kv : seen) {
@@ -463,13 +458,8 @@ TEST(SharedParameters, DefaultOutputLightFileSitsBesideTheProject) {
 // hands the typed text over as a StringValue, which is what these tests feed in.
 
 TEST(TypedPaths, NoFilterDeclaresAFileFieldThatDropsTypedText) {
-  const FitFilter fit;
-  const CoverageFilter coverage;
-  const RelightFilter relight;
-  const SphereFilter sphere;
-  const ImportPhotosFilter import;
   size_t paths = 0;
-  for (const PluginFilter *f : std::vector<const PluginFilter *>{&fit, &coverage, &relight, &sphere, &import})
+  for (const auto &f : make_plugin_filters())
     for (const RichParameter &p : defaults_of(*f)) {
       EXPECT_FALSE(p.value().isFileName()) << utf8(f->name()) << ": '" << utf8(p.name())
                                            << "' is a MeshLab file field, which ignores a typed path";

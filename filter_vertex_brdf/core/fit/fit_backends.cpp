@@ -65,9 +65,9 @@ private:
   std::string name_;
 };
 
-} // namespace
-
-// There the compute shader runs on the same cores as the CPU fit, and slower
+// True for GL implementations that rasterise on the CPU (Mesa llvmpipe/softpipe/swrast, lavapipe,
+// Microsoft's GDI renderer), judged from GL_RENDERER. There the compute shader runs on the same
+// cores as the CPU fit, and slower
 // (tests/benchmark/FIT_PERFORMANCE.md: the CPU reference is 2.4-3.7x faster at the same error).
 bool is_software_renderer(const std::string &gl_renderer) {
   std::string d = gl_renderer;
@@ -76,6 +76,9 @@ bool is_software_renderer(const std::string &gl_renderer) {
     if (d.find(name) != std::string::npos) return true;
   return false;
 }
+
+} // namespace
+
 
 std::unique_ptr<PhongFitter> make_phong_fitter(FitBackendChoice choice, const GetProcAddressFn &get_proc,
                                                const LogFn &log) {

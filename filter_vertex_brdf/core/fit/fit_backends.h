@@ -38,8 +38,4 @@ public:
 std::unique_ptr<PhongFitter> make_phong_fitter(FitBackendChoice choice, const GetProcAddressFn &get_proc,
                                                const LogFn &log);
 
-// True for GL implementations that rasterise on the CPU (Mesa llvmpipe/softpipe/swrast, lavapipe,
-// Microsoft's GDI renderer), judged from GL_RENDERER.
-bool is_software_renderer(const std::string &gl_renderer);
-
 } // namespace vbrdf

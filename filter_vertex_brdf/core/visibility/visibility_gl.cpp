@@ -185,10 +185,9 @@ void GlVisibility::render_depth(const GlRenderTarget &t, const Mat4 &view, const
   check_gl_error(gl_, what);
 }
 
-// Reads the depth of `t` back into depth_ (GL row order: row 0 is the bottom of the image).
+// Reads the depth of `t`, which render_depth has just drawn and left bound, back into depth_ (GL
+// row order: row 0 is the bottom of the image).
 void GlVisibility::read_depth(const GlRenderTarget &t, const std::string &what) {
-  gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
-  gl_.ReadBuffer(GL_COLOR_ATTACHMENT0);
   depth_.resize(size_t(t.width) * size_t(t.height));
   gl_.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
   gl_.PixelStorei(GL_PACK_ALIGNMENT, 4);
