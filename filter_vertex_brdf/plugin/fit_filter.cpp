@@ -20,6 +20,7 @@ const char *const kFitReflectance = "fitReflectance";
 const char *const kFitBackend = "fitBackend";
 const char *const kInitialShininess = "initialShininess";
 const char *const kSpecularLobe = "specularLobe";
+const char *const kDiffuseTerm = "diffuseTerm";
 const char *const kMaxIterations = "maxIterations";
 const char *const kFillUnseenRings = "fillUnseenRings";
 
@@ -96,6 +97,15 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "(N.H, Blinn-Phong; follows glossy highlights seen away from the camera axis "
                            "better). Written with the result (per-vertex lobe_form) and used by every "
                            "later step (relighting, evaluation)."));
+  params.addParam(RichEnum(kDiffuseTerm, int(vbrdf::kFitDiffuseChoice),
+                           QStringList() << "Auto" << "Lambert (thesis)" << "Coated (Fresnel in and out)",
+                           "Diffuse term",
+                           "What k_d multiplies: N.L (Lambert, the thesis) or N.L scaled by a clear coat's "
+                           "Fresnel transmission on the way in and out (varnish, glaze, plastic: the diffuse "
+                           "light dims at grazing light and view; the colour then holds from other cameras). "
+                           "Auto: a quick pilot fit of both with every 4th photo held out picks the one that "
+                           "predicts those photos better (the report says which). Written with the result "
+                           "(per-vertex diffuse_form) and used by every later step."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
@@ -129,12 +139,15 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   require(fill_rings >= 0 && fill_rings <= 1000, kFillUnseenRings, "must be in [0, 1000]");
   const int lobe = params.getEnum(kSpecularLobe);
   require(lobe >= 0 && lobe <= 1, kSpecularLobe, "must be 0 (Phong on R.E) or 1 (Blinn-Phong on N.H)");
+  const int diffuse = params.getEnum(kDiffuseTerm);
+  require(diffuse >= 0 && diffuse <= 2, kDiffuseTerm, "must be 0 (Auto), 1 (Lambert) or 2 (Coated)");
 
   s.fit_reflectance = params.getBool(kFitReflectance);
   s.fit_backend = vbrdf::FitBackendChoice(fit_backend);
   s.phong.alpha_init = alpha0;
   s.phong.max_iterations = iterations;
   s.phong.lobe = vbrdf::LobeForm(lobe);
+  s.diffuse_choice = vbrdf::DiffuseTermChoice(diffuse);
   s.phong.min_specular_samples = shared::min_specular_samples(params);
   s.fill_unseen_rings = fill_rings;
   s.quality = shared::quality_output(params);

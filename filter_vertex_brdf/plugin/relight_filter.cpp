@@ -78,7 +78,9 @@ RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &pa
 namespace {
 
 // The fit filter's per-vertex float attributes, read by name through the result schema.
-std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays, vbrdf::LobeForm &lobe) {
+// The model's forms go into `render` (lobe, diffuse).
+std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &arrays,
+                                             vbrdf::RelightRenderSettings &render) {
   using Alloc = vcg::tri::Allocator<CMeshO>;
   vbrdf::ResultColumns columns;
   for (const vbrdf::ResultAttribute &a : vbrdf::result_schema()) {
@@ -95,12 +97,14 @@ std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &
   std::vector<vbrdf::VertexFit> fits;
   const std::vector<vbrdf::VertexRecord> records = vbrdf::records_from_columns(columns, utf8(mesh.label()));
   for (const vbrdf::VertexRecord &record : records) fits.push_back(record.fit);
-  lobe = vbrdf::lobe_form_of(records, utf8(mesh.label()));
+  render.lobe = vbrdf::lobe_form_of(records, utf8(mesh.label()));
+  render.diffuse = vbrdf::diffuse_form_of(records, utf8(mesh.label()));
   return fits;
 }
 
 // Fits of a saved result PLY, which must be this mesh (same vertices in the same order).
-std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays, vbrdf::LobeForm &lobe) {
+std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const MeshArrays &arrays,
+                                             vbrdf::RelightRenderSettings &render) {
   const vbrdf::ResultPly result = vbrdf::read_result_ply(path);
   const std::vector<float> &p = arrays.data.positions, &q = result.mesh.positions;
   const float tolerance = 1e-4f * std::max(1e-12f, vbrdf::compute_bounds(arrays.data.view()).diagonal());
@@ -110,7 +114,7 @@ std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const Mesh
     throw vbrdf::InputError("The fit result '" + path + "' has " + std::to_string(q.size() / 3) +
                             " vertices that do not match the current mesh (" + std::to_string(p.size() / 3) +
                             " vertices): choose the PLY the fit wrote for this mesh, or clear 'fitResultPly'.");
-  return vbrdf::fits_from_result(result, path, &lobe);
+  return vbrdf::fits_from_result(result, path, &render.lobe, &render.diffuse);
 }
 
 struct RasterSet {
@@ -259,8 +263,8 @@ void RelightFilter::apply(FilterRun &run) const {
   const MeshArrays arrays = mesh_arrays(*mesh);
   const std::string project = project_path(run.document, *mesh);
   const std::vector<vbrdf::VertexFit> fits =
-      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays, s.render.lobe)
-                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays, s.render.lobe);
+      s.fit_result_ply.empty() ? fits_from_mesh(*mesh, arrays, s.render)
+                               : fits_from_file(resolve_path(s.fit_result_ply, project), arrays, s.render);
   const RasterSet set = rasters_to_render(run.document, *mesh, s);
   s.output_folder =
       s.output_folder.empty() ? default_output_folder(set.project) : resolve_path(s.output_folder, project);

@@ -115,18 +115,18 @@ void make_scene(const Args &a, SampleChunk &chunk, std::vector<Truth> &truth) {
       const V3 l = lights[size_t(p)], e = cams[size_t(p)];
       Sample s{};
       s.raster = uint16_t(p);
-      s.n_dot_l = dot(n, l);
-      s.lobe_cos = dot(n * (2 * s.n_dot_l) - l, e);
+      s.d = dot(n, l);
+      s.lobe_cos = dot(n * (2 * s.d) - l, e);
       float clean[3];
-      true_model(truth[v], s.n_dot_l, s.lobe_cos, clean);
+      true_model(truth[v], s.d, s.lobe_cos, clean);
       for (int c = 0; c < 3; ++c)
         s.rgb[c] = std::max(0.0f, clean[c] * (1 + a.noise * gauss(rng)) + 0.1f * a.noise * gauss(rng));
       uint16_t f = 0;
-      if (s.n_dot_l <= 0) f |= kAttachedShadow;
+      if (s.d <= 0) f |= kAttachedShadow;
       else if (u(rng) < 0.05f) f |= kCastShadow, s.rgb[0] *= 0.1f, s.rgb[1] *= 0.1f, s.rgb[2] *= 0.1f;
       if (std::max(s.rgb[0], std::max(s.rgb[1], s.rgb[2])) >= 1.0f) f |= kSaturated;
       for (float &c : s.rgb) c = std::min(c, 1.0f);
-      if (s.n_dot_l > 0 && s.n_dot_l < 0.5f) f |= kGrazing;
+      if (s.d > 0 && s.d < 0.5f) f |= kGrazing;
       if (s.lobe_cos > 0.9f) f |= kHighlight;
       s.flags = f;
       chunk.samples.push_back(s);
@@ -153,7 +153,7 @@ double median(std::vector<double> v) {
 }
 
 bool usable(const Sample &s) {
-  return !(s.flags & (kShadowed | kSaturated | kNotSeen)) && s.n_dot_l > 0;
+  return !(s.flags & (kShadowed | kSaturated | kNotSeen)) && s.d > 0;
 }
 
 void score(const SampleChunk &chunk, const std::vector<Truth> &truth, const std::vector<VertexFit> &fits, Row &r) {
@@ -181,10 +181,10 @@ void score(const SampleChunk &chunk, const std::vector<Truth> &truth, const std:
       const Sample &s = chunk.samples[i];
       if (!usable(s)) continue;
       float fit[3], tru[3];
-      evaluate_phong(f, std::min(s.n_dot_l, 1.0f), s.lobe_cos, fit);
-      true_model(t, std::min(s.n_dot_l, 1.0f), s.lobe_cos, tru);
-      for (int c = 0; c < 3; ++c) model_e += s.n_dot_l * double(fit[c] - tru[c]) * double(fit[c] - tru[c]);
-      model_w += 3 * s.n_dot_l;
+      evaluate_phong(f, std::min(s.d, 1.0f), s.lobe_cos, fit);
+      true_model(t, std::min(s.d, 1.0f), s.lobe_cos, tru);
+      for (int c = 0; c < 3; ++c) model_e += s.d * double(fit[c] - tru[c]) * double(fit[c] - tru[c]);
+      model_w += 3 * s.d;
     }
   }
   r.err_rho = median(e_rho);

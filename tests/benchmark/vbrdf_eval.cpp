@@ -167,7 +167,8 @@ int main(int argc, char **argv) {
   return test::run_tool([&]() -> int {
     const ResultPly result = read_result_ply(result_path);
     LobeForm lobe = LobeForm::PhongRE;
-    const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe);
+    DiffuseForm diffuse = DiffuseForm::Lambert;
+    const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe, &diffuse);
     const MeshView mesh_view = result.mesh.view();
     const LightPlacement placement =
         light_placement_of(mesh_view, dome_radius, light_unit_scale);
@@ -175,6 +176,7 @@ int main(int argc, char **argv) {
     Photos training;
     RelightOptions options;
     options.gather.lobe = lobe;  // the samples' lobe cosine in the form the fit used
+    options.gather.diffuse = diffuse;  // and their diffuse factor
     if (!train_mlp.empty()) {
       training = load_photos(train_mlp, train_lp, train_photo_dir, placement);
       options.training_rasters = &training.project.rasters;
@@ -204,6 +206,7 @@ int main(int argc, char **argv) {
       if (!context) context.reset(new test::OsMesaContext());
       RelightRenderSettings render_settings;
       render_settings.lobe = lobe;
+      render_settings.diffuse = diffuse;
       renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address(), render_settings));
       for (size_t r = 0; r < heldout.project.rasters.size(); ++r)
         rendered.push_back(render_as_photographed(*renderer, heldout.project.rasters[r].shot, heldout.lights[r]));

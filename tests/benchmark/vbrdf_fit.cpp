@@ -3,7 +3,7 @@
 //             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048] [--depth-tests gpu|cpu]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
-//             [--lobe re|nh] [--resolution-weights on|off]
+//             [--lobe re|nh] [--diffuse auto|lambert|coated] [--resolution-weights on|off]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -31,7 +31,7 @@ int usage() {
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
-               "                 [--lobe re|nh] [--resolution-weights on|off]\n";
+               "                 [--lobe re|nh] [--diffuse auto|lambert|coated] [--resolution-weights on|off]\n";
   return 2;
 }
 } // namespace
@@ -58,6 +58,12 @@ int main(int argc, char **argv) {
     else if (a == "--materials") settings.materials = next() == "on";
     else if (a == "--lobe") {
       if (!parse_lobe_form(next(), settings.phong.lobe)) return usage();
+    } else if (a == "--diffuse") {
+      const std::string v = next();
+      if (v == "auto") settings.diffuse_choice = DiffuseTermChoice::Auto;
+      else if (v == "lambert") settings.diffuse_choice = DiffuseTermChoice::Lambert;
+      else if (v == "coated") settings.diffuse_choice = DiffuseTermChoice::Coated;
+      else return usage();
     } else if (a == "--resolution-weights") settings.gather.resolution_weights = next() == "on";
     else if (a == "--material-lobes-everywhere") settings.material_options.keep_full_fits = false;
     else if (a == "--no-robust-colour") settings.material_options.robust_colour = false;

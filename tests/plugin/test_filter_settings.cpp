@@ -68,6 +68,8 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
   EXPECT_EQ(s.fit_reflectance, core.fit_reflectance);
   EXPECT_EQ(s.fit_backend, core.fit_backend);
   EXPECT_FLOAT_EQ(s.phong.alpha_init, core.phong.alpha_init);
+  EXPECT_EQ(s.phong.lobe, vbrdf::kFitLobe);
+  EXPECT_EQ(s.diffuse_choice, vbrdf::kFitDiffuseChoice);
   EXPECT_EQ(s.phong.max_iterations, core.phong.max_iterations);
   EXPECT_EQ(s.phong.min_specular_samples, core.phong.min_specular_samples);
   EXPECT_EQ(s.fill_unseen_rings, core.fill_unseen_rings);
@@ -96,6 +98,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("fitBackend", EnumValue(1));
   p.setValue("initialShininess", FloatValue(20.0f));
   p.setValue("specularLobe", EnumValue(0));
+  p.setValue("diffuseTerm", EnumValue(1));
   p.setValue("maxIterations", IntValue(7));
   p.setValue("minSpecularSamples", IntValue(3));
   p.setValue("fillUnseenRings", IntValue(4));
@@ -114,6 +117,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_EQ(s.gather.encoding, vbrdf::PhotoEncoding::Linear);
   EXPECT_FLOAT_EQ(s.gather.saturation_level, 0.95f);
   EXPECT_EQ(s.phong.lobe, vbrdf::LobeForm::PhongRE);
+  EXPECT_EQ(s.diffuse_choice, vbrdf::DiffuseTermChoice::Lambert);
   EXPECT_EQ(s.gather.photo_cache_bytes, size_t(100) << 20);
   EXPECT_EQ(s.visibility_choice, vbrdf::VisibilityChoice::CPU);
   EXPECT_FLOAT_EQ(s.visibility.depth_tolerance, 0.01f);
@@ -146,6 +150,8 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
   rejects("initialShininess", FloatValue(0.5f));
   rejects("maxIterations", IntValue(-1));
   rejects("specularLobe", EnumValue(2));
+  rejects("diffuseTerm", EnumValue(3));
+  rejects("diffuseTerm", EnumValue(-1));
   rejects("domeRadius", FloatValue(-1.0f));
   rejects("lightUnitScale", FloatValue(std::nanf("")));
   rejects("minSpecularSamples", IntValue(0));

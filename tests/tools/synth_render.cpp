@@ -80,11 +80,24 @@ float gaussian(uint64_t key) {
 
 } // namespace
 
-V3 phong(float kd, float ks, float shininess, V3 color, V3 N, V3 L, V3 V, float irradiance) {
+namespace {
+// Fresnel transmission of unpolarised light into glass (n = 1.5) at incidence cosine ci.
+double glass_transmission(double ci) {
+  ci = std::min(std::max(ci, 0.0), 1.0);
+  const double n = 1.5, ct = std::sqrt(std::max(0.0, 1.0 - (1.0 - ci * ci) / (n * n)));
+  const double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+  return 1.0 - (rs * rs + rp * rp) / 2.0;
+}
+} // namespace
+
+V3 phong(float kd, float ks, float shininess, V3 color, V3 N, V3 L, V3 V, float irradiance, bool coated) {
   const float nl = dot(N, L);
   const V3 R = N * (2 * nl) - L;
   const float spec = ks * std::pow(std::max(dot(R, V), 0.0f), shininess);
-  const float diff = kd * std::max(nl, 0.0f);
+  const double coat = coated ? glass_transmission(nl) * glass_transmission(dot(N, V)) /
+                                   (glass_transmission(1.0) * glass_transmission(1.0))
+                             : 1.0;
+  const float diff = float(kd * std::max(nl, 0.0f) * coat);
   return V3(diff * color.x + spec, diff * color.y + spec, diff * color.z + spec) * irradiance;
 }
 
@@ -173,7 +186,7 @@ cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &r, const Shot &
           const float al = s.shininess[a] * w0 + s.shininess[b] * w1 + s.shininess[c] * w2;
           const V3 C = s.color[a] * w0 + s.color[b] * w1 + s.color[c] * w2;
           // Directional: falloff is exactly 1, so E * 1 keeps the bytes of the directional renders.
-          sum = sum + phong(kd, ks, al, C, N, in.L, normalize(eye - P), set.irradiance * in.falloff);
+          sum = sum + phong(kd, ks, al, C, N, in.L, normalize(eye - P), set.irradiance * in.falloff, set.coated_diffuse);
         }
       sum = sum * (1.0f / float(ss * ss));  // box filter in linear radiance, before clipping
       const float rgb[3] = {sum.x, sum.y, sum.z};

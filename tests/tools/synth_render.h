@@ -19,12 +19,16 @@ struct ShadeSettings {
   bool linear16 = false;    // 16-bit linear PNG instead of 8-bit sRGB
   float noise_sigma = 0;    // Gaussian noise std-dev in linear units (0..1 = full scale)
   uint64_t seed = 1;        // noise seed
+  bool coated_diffuse = false;  // diffuse body under a clear coat of index 1.5 (--coated-diffuse):
+                                //   k_d N.L C scaled by the Fresnel transmission in and out, t(N.L) t(N.V) / t(1)^2
 };
 
 // The model, per colour channel, without the visibility factor:
 //   E * (kd * max(N.L, 0) * C + ks * max(R.V, 0)^shininess),  R = 2 (N.L) N - L
 // N unit normal, L unit direction towards the light, V unit direction towards the camera centre.
-V3 phong(float kd, float ks, float shininess, V3 color, V3 N, V3 L, V3 V, float irradiance);
+// With `coated`, the diffuse term is multiplied by t(N.L) t(N.V) / t(1)^2, t the unpolarised
+// Fresnel transmission into index 1.5 (exact, no clamp: the truth, not the fit's model).
+V3 phong(float kd, float ks, float shininess, V3 color, V3 N, V3 L, V3 V, float irradiance, bool coated = false);
 
 // The light of one photo, world frame: directional (the same direction everywhere) or an
 // isotropic point light whose irradiance at x is E * (reference_distance / |position - x|)^2.

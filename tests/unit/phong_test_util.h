@@ -25,14 +25,14 @@ inline std::vector<Sample> synth_samples(const TruePhong &t, int n, float noise,
   std::vector<Sample> out;
   for (int i = 0; i < n; ++i) {
     Sample s{};
-    s.n_dot_l = 0.1f + 0.9f * u(rng);
+    s.d = 0.1f + 0.9f * u(rng);
     s.lobe_cos = i < nh ? 1.0f - std::min(0.099f, 4.0f / t.alpha) * u(rng) : -1.0f + 1.9f * u(rng);
     const float g = s.lobe_cos > 0 ? std::pow(s.lobe_cos, t.alpha) : 0.0f;
     for (int c = 0; c < 3; ++c) {
-      const float clean = t.rho[c] * s.n_dot_l + t.ks * g;
+      const float clean = t.rho[c] * s.d + t.ks * g;
       s.rgb[c] = std::max(0.0f, clean * (1 + noise * gauss(rng)));
     }
-    s.flags = (s.lobe_cos > 0.9f ? kHighlight : 0) | (s.n_dot_l < 0.5f ? kGrazing : 0);
+    s.flags = (s.lobe_cos > 0.9f ? kHighlight : 0) | (s.d < 0.5f ? kGrazing : 0);
     out.push_back(s);
   }
   return out;

@@ -55,7 +55,7 @@ Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed, LobeF
       const float E[3] = {0, 0, 1};
       const float re = lobe_cosine(LobeForm::PhongRE, N, L, E), s = lobe_cosine(form, N, L, E);
       Sample smp{};
-      smp.n_dot_l = d, smp.lobe_cos = s, smp.raster = uint16_t(l);
+      smp.d = d, smp.lobe_cos = s, smp.raster = uint16_t(l);
       const float g = glossy && s > 0 && d > 0 ? ks * std::pow(s, alpha) : 0.0f;
       for (int c = 0; c < 3; ++c) smp.rgb[c] = std::max(0.0f, (rho[c] * std::max(d, 0.0f) + g) * (1 + 0.01f * gauss(rng)));
       smp.flags = uint16_t((d <= 0 ? kAttachedShadow : 0) | (d > 0 && d < 0.2f ? kGrazing : 0) | (re > 0.9f ? kHighlight : 0));

@@ -107,7 +107,7 @@ Sample lambert(float d, uint16_t flags) {
   Sample s{};
   const float rho[3] = {0.6f, 0.4f, 0.2f};
   for (int c = 0; c < 3; ++c) s.rgb[c] = rho[c] * d;
-  s.n_dot_l = d;
+  s.d = d;
   s.lobe_cos = -0.5f;
   s.flags = flags;
   return s;

@@ -127,12 +127,12 @@ std::vector<Sample> half_angle_vertex(const float e[3], float alpha, LobeForm fo
       l[k] = std::cos(th) * mirror[k] + std::sin(th) * (std::cos(ph) * t1[k] + std::sin(ph) * t2[k]);
     if (l[2] <= 0.05f) continue;
     Sample s{};
-    s.n_dot_l = l[2];
+    s.d = l[2];
     const float nh = lobe_cosine(LobeForm::BlinnNH, nrm, l, e), re = lobe_cosine(LobeForm::PhongRE, nrm, l, e);
     s.lobe_cos = form == LobeForm::BlinnNH ? nh : re;
     const float g = nh > 0 ? std::pow(nh, alpha) : 0.0f;
-    for (int c = 0; c < 3; ++c) s.rgb[c] = rho[c] * s.n_dot_l + ks * g;
-    s.flags = (re > 0.9f ? kHighlight : 0) | (s.n_dot_l < 0.5f ? kGrazing : 0);
+    for (int c = 0; c < 3; ++c) s.rgb[c] = rho[c] * s.d + ks * g;
+    s.flags = (re > 0.9f ? kHighlight : 0) | (s.d < 0.5f ? kGrazing : 0);
     out.push_back(s);
   }
   return out;

@@ -61,7 +61,7 @@ void usable_counts(const SampleChunk &chunk, uint32_t v, const PhongFitOptions &
   n = n_high = 0;
   for (uint32_t i = chunk.offsets[v]; i < chunk.offsets[v + 1]; ++i) {
     const Sample &s = chunk.samples[i];
-    if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0) || !std::isfinite(s.n_dot_l)) continue;
+    if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.d > 0) || !std::isfinite(s.d)) continue;
     if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) ||
         !std::isfinite(s.lobe_cos))
       continue;
@@ -200,17 +200,17 @@ std::vector<Sample> degenerate_vertex(Kind kind, std::mt19937 &rng) {
   switch (kind) {
   case kAllEqual: for (auto &x : s) x = s[0]; break;
   case kSingle: s.resize(1); break;
-  case kAllGrazing: for (auto &x : s) x.n_dot_l = 1e-4f * u(rng), x.flags |= kGrazing; break;
+  case kAllGrazing: for (auto &x : s) x.d = 1e-4f * u(rng), x.flags |= kGrazing; break;
   case kSToZero: for (auto &x : s) x.lobe_cos = 1e-30f * u(rng); break;
   case kSToOne: for (auto &x : s) x.lobe_cos = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
-  case kDuplicateLights: for (auto &x : s) x.n_dot_l = s[0].n_dot_l, x.lobe_cos = s[0].lobe_cos; break;
+  case kDuplicateLights: for (auto &x : s) x.d = s[0].d, x.lobe_cos = s[0].lobe_cos; break;
   case kZeroPixels: for (auto &x : s) x.rgb[0] = x.rgb[1] = x.rgb[2] = 0; break;
   case kSaturatedOnly: for (auto &x : s) x.flags |= kSaturated; break;
   case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().lobe_cos = std::nanf(""); break;
   case kHugeValues: for (auto &x : s) x.rgb[0] *= 1e6f; break;
   case kTinyValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e-30f; break;
   case kExtremeValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e30f; break;  // squares overflow float
-  case kInfNdotL: s[0].n_dot_l = INFINITY; break;
+  case kInfNdotL: s[0].d = INFINITY; break;
   default: break;
   }
   return s;

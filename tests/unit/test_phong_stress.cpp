@@ -22,10 +22,10 @@ std::vector<Sample> make_vertex(Kind kind, std::mt19937 &rng) {
   switch (kind) {
   case kAllEqual: for (auto &x : s) x = s[0]; break;
   case kSingle: s.resize(1); break;
-  case kAllGrazing: for (auto &x : s) x.n_dot_l = 1e-4f * u(rng), x.flags |= kGrazing; break;
+  case kAllGrazing: for (auto &x : s) x.d = 1e-4f * u(rng), x.flags |= kGrazing; break;
   case kSToZero: for (auto &x : s) x.lobe_cos = 1e-30f * u(rng); break;
   case kSToOne: for (auto &x : s) x.lobe_cos = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
-  case kDuplicateLights: for (auto &x : s) x.n_dot_l = s[0].n_dot_l, x.lobe_cos = s[0].lobe_cos; break;
+  case kDuplicateLights: for (auto &x : s) x.d = s[0].d, x.lobe_cos = s[0].lobe_cos; break;
   case kZeroPixels: for (auto &x : s) x.rgb[0] = x.rgb[1] = x.rgb[2] = 0; break;
   case kSaturatedOnly: for (auto &x : s) x.flags |= kSaturated; break;
   case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().lobe_cos = std::nanf(""); break;

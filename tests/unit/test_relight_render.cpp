@@ -75,11 +75,12 @@ struct PlaneCheck {
   size_t checked = 0, shadowed = 0, unfitted = 0;
   double worst = 0, brightest = 0, darkest = 1e9;
 };
-PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light) {
+PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
+                        const RelightRenderSettings &settings = RelightRenderSettings()) {
   const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
   const float rho[3] = {0.5f, 0.3f, 0.1f};
   const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
-  RelightRenderer renderer(mesh.view(), fits, ctx.get_proc_address());
+  RelightRenderer renderer(mesh.view(), fits, ctx.get_proc_address(), settings);
   const Shot shot = top_camera();
   const RelitImage r = renderer.render(shot, light);
   EXPECT_EQ(r.width, kW);
@@ -98,7 +99,7 @@ PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light) {
       const float d = n * lv;
       const vcg::Point3f refl = n * (2 * d) - lv;
       float expected[3];
-      evaluate_phong(fits[0], d, refl * e, expected);
+      evaluate_phong(fits[0], diffuse_factor(settings.diffuse, d, n * e), refl * e, expected);
       const float irradiance = light_irradiance_at(light, pf);
       for (int k = 0; k < 3; ++k)
         c.worst = std::max(c.worst, double(std::fabs(pixel(r, x, y)[k] - expected[k] * irradiance)));
@@ -116,6 +117,21 @@ TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
   EXPECT_EQ(c.unfitted, 0u);
   EXPECT_GT(c.checked, 500u);  // the plane fills the view
   EXPECT_LT(c.worst, 2e-3);
+}
+
+// The coated diffuse form (diffuse_form.h): the shader's copy agrees with the CPU's, and it is in
+// effect (a low light dims the coated render against the Lambertian one).
+TEST(RelightRender, CoatedDiffuseMatchesTheModelEverywhere) {
+  REQUIRE_GL(ctx);
+  const LightSource low = LightSource::directional({{1.0f, 0.3f, 0.2f}});  // N.L about 0.28
+  RelightRenderSettings coated;
+  coated.diffuse = DiffuseForm::Coated;
+  const PlaneCheck c = render_plane(*ctx, low, coated);
+  EXPECT_GT(c.checked, 500u);
+  EXPECT_LT(c.worst, 2e-3);
+  const PlaneCheck lambert = render_plane(*ctx, low);
+  EXPECT_LT(lambert.worst, 2e-3);
+  EXPECT_LT(c.brightest, 0.9 * lambert.brightest);  // T(0.28)/T(1) is about 0.78
 }
 
 // A point light close over the plane: per pixel its own direction and the inverse-square fall-off.

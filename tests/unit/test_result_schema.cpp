@@ -55,7 +55,7 @@ TEST(ResultSchema, FileFormatIsTheDocumentedOne) {
       "float diffuse_r", "float diffuse_g", "float diffuse_b", "float n_visible", "float n_diffuse",
       "float n_specular", "float coloured", "float kd", "float ks", "float shininess", "float color_r",
       "float color_g", "float color_b", "float dq", "float sq", "float fit_rmse", "float fit_status",
-      "float fit_iterations", "float material", "float lobe_form"};
+      "float fit_iterations", "float material", "float lobe_form", "float diffuse_form"};
   const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
   const size_t n = mesh.positions.size() / 3;
   const std::string dir = test::scratch_dir("schema_format");

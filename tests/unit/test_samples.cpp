@@ -45,7 +45,7 @@ TEST(Samples, HeadOnLightIsHighlightAndColourIsDecoded) {
   Fixture f;
   const Sample s = f.sample(kOrigin, kFacing, kFacing);
   EXPECT_EQ(s.raster, 3);
-  EXPECT_NEAR(s.n_dot_l, 1, 1e-6);
+  EXPECT_NEAR(s.d, 1, 1e-6);
   EXPECT_NEAR(s.lobe_cos, 1, 1e-6);
   EXPECT_EQ(s.flags, kHighlight);
   EXPECT_NEAR(s.rgb[0], srgb_to_linear(200 / 255.0f), 1e-5);  // BGR on disk
@@ -58,7 +58,7 @@ TEST(Samples, DiffuseGrazingAndShadowFlags) {
   const LightSource side60 = LightSource::directional({{0.8660254f, 0, 0.5f}});  // N.L = 0.5 exactly at the threshold: not grazing
   Sample s = f.sample(kOrigin, kFacing, side60);
   EXPECT_EQ(s.flags, 0) << s.flags;
-  EXPECT_NEAR(s.n_dot_l, 0.5, 1e-6);
+  EXPECT_NEAR(s.d, 0.5, 1e-6);
   EXPECT_NEAR(s.lobe_cos, 0.5, 1e-2);  // R = (-0.866, 0, 0.5), E ~ (0, 0, 1)
   EXPECT_TRUE(is_diffuse_sample(s));
   const float graze[3] = {0.97f, 0, 0.2431f};
@@ -66,6 +66,23 @@ TEST(Samples, DiffuseGrazingAndShadowFlags) {
   const float behind[3] = {0, 0, -1};
   EXPECT_EQ(f.sample(kOrigin, kFacing, behind).flags, kAttachedShadow);
   EXPECT_EQ(f.sample(kOrigin, kFacing, side60, true, false).flags, kCastShadow);
+}
+
+// The gatherer stores the diffuse form's factor in Sample::d; the grazing flag stays on plain N.L.
+TEST(Samples, DiffuseFactorFollowsTheForm) {
+  Fixture f;
+  const float low[3] = {-0.5f, 0, 0.8660254f};  // 60 degrees off the camera axis
+  const float tilted[3] = {0.6f, 0, 0.8f};        // a normal at N.E = 0.8 (camera on +z): N.L = 0.393
+  const Sample lambert = f.sample(kOrigin, tilted, low);
+  f.settings.diffuse = DiffuseForm::Coated;
+  const Sample coated = f.sample(kOrigin, tilted, low);
+  const float nl = -0.6f * 0.5f + 0.8f * 0.8660254f, ne = 0.8f;
+  EXPECT_NEAR(lambert.d, nl, 1e-3);
+  EXPECT_NEAR(coated.d, diffuse_factor(DiffuseForm::Coated, nl, ne), 2e-3);
+  EXPECT_LT(coated.d, 0.95f * lambert.d);
+  EXPECT_EQ(coated.flags, lambert.flags);
+  const float graze[3] = {0.97f, 0, 0.2431f};
+  EXPECT_EQ(f.sample(kOrigin, kFacing, graze).flags, kGrazing);  // N.L < T_d, coated or not
 }
 
 TEST(Samples, NotSeenCases) {
@@ -173,7 +190,7 @@ TEST(Samples, CleanSamplesArePreferredOverRimOnes) {
   SampleChunk c;
   c.first_vertex = 0;
   c.vertex_count = 2;
-  auto s = [](uint16_t flags) { Sample x{}; x.n_dot_l = 0.8f; x.flags = flags; return x; };
+  auto s = [](uint16_t flags) { Sample x{}; x.d = 0.8f; x.flags = flags; return x; };
   // vertex 0: 2 clean + 1 rim -> the rim sample is left out; vertex 1: 1 clean + 1 rim -> kept.
   c.samples = {s(0), s(0), s(kRimFootprint), s(0), s(kRimFootprint)};
   c.offsets = {0, 3, 5};

@@ -21,14 +21,14 @@ void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *f
     for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
       const Sample &s = chunk.samples[k];
       // The fit's usable-sample rules (phong_fit_cpu.cpp usable_samples), strict or weak.
-      if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0)) continue;
+      if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.d > 0)) continue;
       if ((s.flags & kMixedPixel) && !weak) continue;
       if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) continue;
       if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) ||
-          !std::isfinite(s.lobe_cos) || !std::isfinite(s.n_dot_l))
+          !std::isfinite(s.lobe_cos) || !std::isfinite(s.d))
         continue;
-      const float w = s.n_dot_l * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
-      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.n_dot_l, 1.0f), s.lobe_cos, w, s.raster,
+      const float w = s.d * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
+      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.d, 1.0f), s.lobe_cos, w, s.raster,
                        uint16_t(s.flags | s.resolution << 10)});
     }
     end_[v] = data_.size();

@@ -3,9 +3,10 @@
 // precision, OpenMP) and the GPU back end (shaders/phong_fit.comp, float32).
 //
 // Model, per colour channel c, light of unit irradiance and white colour (after calibration):
-//     f_c = k_d (N.L) C_c + k_s max(s, 0)^alpha,  s = R.E or N.H (options.lobe, samples/lobe.h)
+//     f_c = k_d d C_c + k_s max(s, 0)^alpha,  s = R.E or N.H (options.lobe, samples/lobe.h),
+//     d = N.L, or N.L with the coat's Fresnel transmission (options.diffuse, samples/diffuse_form.h)
 // Objective: sum over usable samples i of w_i * sum_c (P_ic - f_c)^2 + prior, with
-//     w_i = N.L_i (thesis ch. 5) times the sample's photo resolution weight (resolution_weight,
+//     w_i = d_i (N.L_i in the thesis, ch. 5) times the sample's photo resolution weight (resolution_weight,
 //     1 with one camera), highlight samples rescaled so that their total weight is at
 //     most `specular_weight_cap` times the weight of the other samples (diffuse-hole remedy 1),
 //     prior = diffuse_prior * W * sum_c (rho_c - rho0_c)^2, rho = k_d C, rho0 the diffuse-only
@@ -61,6 +62,10 @@ struct PhongFitOptions {
   // The lobe's form: which cosine Sample::lobe_cos holds and alpha applies to (lobe.h). The
   // thresholds above stay stated on R.E and are converted by lobe_threshold().
   LobeForm lobe = LobeForm::PhongRE;
+  // The diffuse term's form (diffuse_form.h). The fit itself never evaluates it: the samples carry
+  // d already (Sample::d; pipeline.cpp copies this into GatherSettings::diffuse); the result and the
+  // renderers take it from here.
+  DiffuseForm diffuse = DiffuseForm::Lambert;
 };
 
 enum FitStatus : uint8_t {
@@ -113,7 +118,8 @@ void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOp
                            VertexFit &fit);
 
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
-void evaluate_phong(const VertexFit &fit, float n_dot_l, float lobe_cos, float out_rgb[3]);
+// d: the diffuse factor (Sample::d: N.L for Lambert, diffuse_factor() in general).
+void evaluate_phong(const VertexFit &fit, float d, float lobe_cos, float out_rgb[3]);
 
 // True when the vertex has a reflectance model (any status but kFitNone).
 inline bool has_model(const VertexFit &fit) { return fit.status != kFitNone; }

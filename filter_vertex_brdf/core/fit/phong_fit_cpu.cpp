@@ -178,8 +178,8 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 
 } // namespace
 
-void evaluate_phong(const VertexFit &fit, float n_dot_l, float lobe_cos, float out[3]) {
-  const float d = std::max(n_dot_l, 0.0f);
+void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, float out[3]) {
+  const float d = std::max(d_in, 0.0f);
   const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe(lobe_cos, fit.shininess)) : 0.0f;
   for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
 }
@@ -195,17 +195,17 @@ int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std
   int n_high = 0;
   for (size_t i = 0; i < count; ++i) {
     const Sample &s = in[i];
-    if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.n_dot_l > 0)) continue;
+    if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.d > 0)) continue;
     if ((s.flags & kMixedPixel) && !weak) continue;
     // Grazing light (N.L < T_d) is as unreliable for the fit as for the basic colour (normal
     // errors, shading-model breakdown); a grazing highlight is still specular evidence.
     if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) continue;
     if (!std::isfinite(s.rgb[0]) || !std::isfinite(s.rgb[1]) || !std::isfinite(s.rgb[2]) || !std::isfinite(s.lobe_cos) ||
-        !std::isfinite(s.n_dot_l))
+        !std::isfinite(s.d))
       continue;  // a corrupt sample is not evidence
     const double w =
-        s.n_dot_l * double(resolution_weight(s)) * ((s.flags & kMixedPixel) ? double(o.mixed_sample_weight) : 1.0);
-    FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.n_dot_l, 1.0), s.lobe_cos, w,
+        s.d * double(resolution_weight(s)) * ((s.flags & kMixedPixel) ? double(o.mixed_sample_weight) : 1.0);
+    FitSample x{{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min<double>(s.d, 1.0), s.lobe_cos, w,
                 s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold)};
     (x.highlight ? w_high : w_other) += x.w;
     n_high += x.highlight;

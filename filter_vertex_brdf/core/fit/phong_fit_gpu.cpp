@@ -91,7 +91,7 @@ void work_order(const SampleChunk &chunk, uint32_t first, uint32_t end, const Ph
     int n_high = 0, n_lobe = 0;
     for (uint32_t k = chunk.offsets[first + i]; k < chunk.offsets[first + i + 1]; ++k) {
       const Sample &s = chunk.samples[k];
-      const bool usable = !(s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) && s.n_dot_l > 0;
+      const bool usable = !(s.flags & (kShadowed | kSaturated | kNotSeen | kMixedPixel)) && s.d > 0;
       n_high += usable && s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold);
       n_lobe += usable && s.lobe_cos > lobe_threshold(o.lobe, o.lobe_threshold);
     }

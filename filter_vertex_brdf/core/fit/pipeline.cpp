@@ -14,6 +14,7 @@
 #include "inputs/light_file.h"
 #include "inputs/light_source.h"
 #include "inputs/photo_prefetch.h"
+#include "fit/diffuse_choice.h"
 #include "io/fit_outputs.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
@@ -134,6 +135,27 @@ void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &
 
 } // namespace
 
+namespace {
+// Sets settings.phong.diffuse and settings.gather.diffuse (one diffuse form for the samples, the fit
+// and the result) from settings.diffuse_choice; Auto runs the pilot of diffuse_choice.h.
+void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &lights, const VisibilityMasks &masks,
+                         PhotoCache &photos, const std::function<void(SampleChunk &)> &prepare, const LogFn &log,
+                         FitSettings &settings, FitResult &result) {
+  if (!settings.fit_reflectance || settings.diffuse_choice != DiffuseTermChoice::Auto) {
+    result.diffuse_form = settings.diffuse_choice == DiffuseTermChoice::Coated ? DiffuseForm::Coated : DiffuseForm::Lambert;
+    result.diffuse_choice_note = std::string(diffuse_form_name(result.diffuse_form)) +
+                                 (settings.fit_reflectance ? " (as set)" : " (no Phong fit: the thesis's form)");
+  } else {
+    const DiffuseChoice choice =
+        choose_diffuse_form(input.mesh, input.rasters, lights, masks, settings.gather, settings.phong, photos, prepare);
+    result.diffuse_form = choice.form;
+    result.diffuse_choice_note = choice.note + (choice.piloted ? ", " + fixed(choice.seconds) + " s" : "");
+    log("Vertex BRDF: diffuse term " + result.diffuse_choice_note + ".");
+  }
+  settings.phong.diffuse = settings.gather.diffuse = result.diffuse_form;
+}
+} // namespace
+
 FitResult run_fit(const FitInput &input, const FitSettings &settings_in, VisibilityBackend &visibility,
                   PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {
   validate_input(input);
@@ -220,6 +242,11 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
                                 "the other photos were used without it.");
       log(result.warnings.back());
     }
+
+  decide_diffuse_form(input, lights, masks, photos, [&](SampleChunk &chunk) {
+    if (correct) correct_samples(colors, chunk);
+    apply_light_falloff(chunk, mesh, lights);
+  }, log, settings, result);
 
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);

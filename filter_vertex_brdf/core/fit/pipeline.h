@@ -39,6 +39,12 @@ constexpr float kFitDiffuseThreshold = 0.2f;
 // core contract's default; the pipeline copies phong.lobe into gather.lobe.
 constexpr LobeForm kFitLobe = LobeForm::BlinnNH;
 
+// How the fit's diffuse form (diffuse_form.h) is decided. Auto (the product's default): a pilot fit
+// on each form with photos held out picks it per scene (diffuse_choice.h; README "The diffuse
+// term's form" has the measurements behind it); Lambert / Coated: as given.
+enum class DiffuseTermChoice { Auto = 0, Lambert = 1, Coated = 2 };
+constexpr DiffuseTermChoice kFitDiffuseChoice = DiffuseTermChoice::Auto;
+
 struct FitSettings {
   FitSettings() {
     gather.diffuse_threshold = kFitDiffuseThreshold;
@@ -48,7 +54,9 @@ struct FitSettings {
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;
   bool fit_reflectance = true;         // false: basic diffuse colour only (no k_d/k_s/alpha)
-  PhongFitOptions phong;               // its specular_threshold is taken from gather
+  PhongFitOptions phong;               // its specular_threshold is taken from gather; its diffuse
+                                       //   form from diffuse_choice
+  DiffuseTermChoice diffuse_choice = kFitDiffuseChoice;
   FitBackendChoice fit_backend = FitBackendChoice::Auto;
   QualityOutput quality = QualityOutput::DQ;  // what goes into vertex quality
   ColorCorrectionChoice color_correction = ColorCorrectionChoice::Auto;
@@ -108,6 +116,8 @@ struct FitResult {
   size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
   NeighbourFillStats fill;
   MaterialResult materials;               // material stage (FitSettings::materials); label empty when off
+  DiffuseForm diffuse_form = DiffuseForm::Lambert;  // the form fitted (FitSettings::diffuse_choice)
+  std::string diffuse_choice_note;        // how it was decided (report line; diffuse_choice.h for Auto)
   double seconds_fit = 0;
   std::string light_file;                 // the light file used (.lp, .json or .dome)
   std::string light_model;                // describe_lights: directional / point lights and their distances

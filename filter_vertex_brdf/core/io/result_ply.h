@@ -25,7 +25,9 @@ ResultPly read_result_ply(const std::string &path);
 // every Phong attribute present is read (dq, sq, fit_rmse and fit_iterations may be absent: 0).
 // Throws InputError naming the first missing attribute needed for the model (kd, ks, shininess,
 // color_r/g/b, fit_status), or a column of the wrong length.
-// `lobe` (optional) receives the result's lobe form (lobe_form_of).
-std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe = nullptr);
+// `lobe` and `diffuse` (optional) receive the result's lobe and diffuse forms (lobe_form_of,
+// diffuse_form_of).
+std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe = nullptr,
+                                        DiffuseForm *diffuse = nullptr);
 
 } // namespace vbrdf

@@ -63,6 +63,10 @@ std::vector<ResultAttribute> make_schema() {
        "the specular lobe's form that shininess applies to: 0 Phong on R.E (the thesis), 1 Blinn-Phong on N.H "
        "(absent: 0)",
        [](const R &r) { return r.lobe_form; }, [](R &r, float v) { r.lobe_form = whole(v, 1.0f); }},
+      {"diffuse_form", K::Code, G::PhongFit, false,
+       "the diffuse term's form that kd multiplies: 0 Lambert (N.L, the thesis), 1 coated (N.L with a clear "
+       "coat's Fresnel transmission in and out, index 1.5) (absent: 0)",
+       [](const R &r) { return r.diffuse_form; }, [](R &r, float v) { r.diffuse_form = whole(v, 1.0f); }},
   };
 }
 } // namespace
@@ -118,13 +122,29 @@ std::vector<VertexRecord> records_from_columns(const ResultColumns &columns, con
   return records;
 }
 
-LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
+namespace {
+// The one 0/1 code that the modelled vertices of a result share for a per-result form attribute.
+bool form_code_of(const std::vector<VertexRecord> &records, float VertexRecord::*code, const char *attribute,
+                  const char *what, const std::string &source) {
   bool seen[2] = {false, false};
   for (const VertexRecord &r : records)
-    if (has_model(r.fit)) seen[r.lobe_form > 0.5f ? 1 : 0] = true;
+    if (has_model(r.fit)) seen[r.*code > 0.5f ? 1 : 0] = true;
   if (seen[0] && seen[1])
-    throw InputError("Result '" + source + "' mixes lobe forms (per-vertex 'lobe_form' 0 and 1): refit it in one run.");
-  return seen[1] ? LobeForm::BlinnNH : LobeForm::PhongRE;
+    throw InputError("Result '" + source + "' mixes " + what + " (per-vertex '" + attribute +
+                     "' 0 and 1): refit it in one run.");
+  return seen[1];
+}
+} // namespace
+
+LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
+  return form_code_of(records, &VertexRecord::lobe_form, "lobe_form", "lobe forms", source) ? LobeForm::BlinnNH
+                                                                                           : LobeForm::PhongRE;
+}
+
+DiffuseForm diffuse_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
+  return form_code_of(records, &VertexRecord::diffuse_form, "diffuse_form", "diffuse forms", source)
+             ? DiffuseForm::Coated
+             : DiffuseForm::Lambert;
 }
 
 } // namespace vbrdf

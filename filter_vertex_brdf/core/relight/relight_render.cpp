@@ -67,6 +67,9 @@ in float v_depth;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
 uniform int u_half_angle_lobe;
+uniform int u_coated_diffuse;
+uniform float u_coat_index;
+uniform float u_coat_min_n_dot_e;
 uniform mat4 u_light_view;
 uniform float u_light_scale;
 uniform int u_light_perspective;
@@ -82,6 +85,21 @@ layout(location = 1) out float o_depth;
 float shadow_texel(int i, int j) {
   ivec2 p = clamp(ivec2(i, j), ivec2(0), ivec2(u_shadow_size - 1));
   return texelFetch(u_shadow_map, p, 0).r;
+}
+
+// samples/diffuse_form.h coat_transmission / diffuse_factor, term for term.
+float coat_transmission(float c) {
+  c = clamp(c, 0.0, 1.0);
+  float sin_t = sqrt(max(0.0, 1.0 - c * c)) / u_coat_index;
+  float cos_t = sqrt(max(0.0, 1.0 - sin_t * sin_t));
+  float rs = (c - u_coat_index * cos_t) / (c + u_coat_index * cos_t);
+  float rp = (u_coat_index * c - cos_t) / (u_coat_index * c + cos_t);
+  return 1.0 - 0.5 * (rs * rs + rp * rp);
+}
+float diffuse_factor(float n_dot_l, float n_dot_e) {
+  if (u_coated_diffuse == 0 || !(n_dot_l > 0.0)) return n_dot_l;
+  float t1 = coat_transmission(1.0);
+  return n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
 }
 
 void main() {
@@ -117,7 +135,7 @@ void main() {
   float spec = 0.0;
   if (v_ks_alpha.x > 0.0 && s > 0.0)
     spec = v_ks_alpha.x * exp(max(v_ks_alpha.y * log(min(s, 1.0)), -80.0));
-  o_color = vec4((v_rho_fitted.rgb * d + vec3(spec)) * irradiance, 1.0);
+  o_color = vec4((v_rho_fitted.rgb * diffuse_factor(d, dot(n, e)) + vec3(spec)) * irradiance, 1.0);
 }
 )";
 
@@ -312,6 +330,9 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_half_angle_lobe"), settings_.lobe == LobeForm::BlinnNH ? 1 : 0);
+  gl_.Uniform1i(gl_.GetUniformLocation(p, "u_coated_diffuse"), settings_.diffuse == DiffuseForm::Coated ? 1 : 0);
+  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_coat_index"), kCoatIndex);
+  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_coat_min_n_dot_e"), kCoatMinNdotE);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), lv.scale);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_light_perspective"), lv.perspective ? 1 : 0);

@@ -9,7 +9,7 @@
 // Shading is per pixel: the vertex normal and the model parameters (rho = k_d C, k_s, alpha) are
 // interpolated over each triangle and the model is evaluated per fragment as evaluate_phong does
 // (E from the fragment to the camera centre; the lobe's cosine R.E, R = 2(N.L)N - L, or N.H as
-// settings.lobe says). Where k_s = 0 the shininess is
+// settings.lobe says; the diffuse factor N.L or coated as settings.diffuse says, diffuse_form.h). Where k_s = 0 the shininess is
 // undefined (0); such vertices take the median shininess of the fitted lobes, so that a lobe fades
 // with k_s across a triangle instead of widening. Lights are directional with unit irradiance, as
 // in the fit: the render is in the photos' linear units.
@@ -56,6 +56,7 @@ struct RelightRenderSettings {
                                   // fit's visibility pass (resolved_shadow_map_size)
   float depth_tolerance = 0.002f; // shadow test slack, fraction of the bounding-box diagonal
   LobeForm lobe = LobeForm::PhongRE;  // the fit's lobe form (its result's lobe_form; lobe.h)
+  DiffuseForm diffuse = DiffuseForm::Lambert;  // the fit's diffuse form (its result's diffuse_form; diffuse_form.h)
 };
 
 // Renders one mesh with its per-vertex fits (one VertexFit per vertex). The mesh and the fits are

@@ -22,7 +22,7 @@ size_t reject_outliers(std::vector<Sample> &used, const float rho[3]) {
   if (used.size() < 4) return 0;
   const float rho_y = luminance(rho);
   std::vector<float> residuals(used.size());
-  for (size_t i = 0; i < used.size(); ++i) residuals[i] = luminance(used[i].rgb) - rho_y * used[i].n_dot_l;
+  for (size_t i = 0; i < used.size(); ++i) residuals[i] = luminance(used[i].rgb) - rho_y * used[i].d;
   std::vector<float> abs_dev(residuals.size());
   for (size_t i = 0; i < residuals.size(); ++i) abs_dev[i] = std::fabs(residuals[i]);
   const float mad = median(abs_dev);
@@ -39,7 +39,7 @@ size_t reject_outliers(std::vector<Sample> &used, const float rho[3]) {
 bool least_squares_reflectance(const Sample *samples, size_t count, float out_rgb[3]) {
   double dd = 0, dp[3] = {0, 0, 0};
   for (size_t i = 0; i < count; ++i) {
-    const double d = samples[i].n_dot_l;
+    const double d = samples[i].d;
     dd += d * d;
     for (int c = 0; c < 3; ++c) dp[c] += d * double(samples[i].rgb[c]);
   }

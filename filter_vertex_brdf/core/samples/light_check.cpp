@@ -20,7 +20,7 @@ void LightAgreement::add(const SampleChunk &chunk, const MeshView &mesh, const s
       const Sample &s = chunk.samples[k];
       if ((s.flags & (kSaturated | kMixedPixel)) || s.raster >= n_.size()) continue;
       // N.L signed (not clamped): the vertices facing away from the light must be the dark ones.
-      const double predicted = double(s.n_dot_l) * light_irradiance_at(lights[s.raster], x);
+      const double predicted = double(s.d) * light_irradiance_at(lights[s.raster], x);
       const double lum = 0.2126 * s.rgb[0] + 0.7152 * s.rgb[1] + 0.0722 * s.rgb[2];
       if (!std::isfinite(predicted) || !std::isfinite(lum)) continue;
       const size_t r = s.raster;

@@ -174,7 +174,7 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
   light_direction_at(light, position, light_dir);
   const float d = dot3(n, light_dir);
   const float s = lobe_cosine(LobeForm::PhongRE, n, light_dir, e);  // R.E: decides kHighlight
-  out.n_dot_l = d;
+  out.d = diffuse_factor(settings.diffuse, d, dot3(n, e));
   out.lobe_cos = settings.lobe == LobeForm::PhongRE ? s : lobe_cosine(settings.lobe, n, light_dir, e);
   if (d <= 0) flags |= kAttachedShadow;
   if (!light_clear) flags |= kCastShadow;

@@ -14,6 +14,7 @@
 
 #include "base/callbacks.h"  // ProgressFn
 #include "inputs/camera.h"
+#include "samples/diffuse_form.h"
 #include "samples/lobe.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
@@ -41,7 +42,8 @@ constexpr uint16_t kShadowed = kAttachedShadow | kCastShadow;
 
 struct Sample {
   float rgb[3];      // linear pixel colour (bilinear)
-  float n_dot_l;     // d = N.L
+  float d;           // the diffuse factor: N.L, or with the coat's Fresnel transmission
+                     //   (GatherSettings::diffuse, diffuse_form.h); <= 0 exactly when N.L <= 0
   float lobe_cos;    // s: the specular lobe's cosine, R.E or N.H (GatherSettings::lobe, lobe.h);
                      //   E = unit vector from the vertex to the camera centre
   uint16_t raster;   // index of the photo
@@ -92,6 +94,9 @@ struct GatherSettings {
   // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
   // (pipeline.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
   LobeForm lobe = LobeForm::PhongRE;
+  // The diffuse term's form stored in Sample::d (diffuse_form.h); the fit's PhongFitOptions::diffuse
+  // (pipeline.cpp keeps them equal). kGrazing stays N.L < T_d on the plain cosine.
+  DiffuseForm diffuse = DiffuseForm::Lambert;
   // Weight samples by their photo's resolution of the vertex (Sample::resolution); false: every
   // code 0 (all photos alike). Off by default: on the spot pair the two-camera fit scored worse
   // with it (README "The lobe's form and several cameras").

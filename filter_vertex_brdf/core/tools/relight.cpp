@@ -225,14 +225,14 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         if (s.raster >= n_held) continue;  // training photo
         if (s.flags & kSaturated) continue;
         if (options.lit_filter ? !(*options.lit_filter)[size_t(s.raster) * mesh.vertex_count + v]
-                               : ((s.flags & kShadowed) || !(s.n_dot_l > 0)))
+                               : ((s.flags & kShadowed) || !(s.d > 0)))
           continue;
         Scored r{};
         r.raster = s.raster;
         r.mixed = (s.flags & kMixedPixel) != 0;
         r.modelled = has_model(fit);
         float predicted[3];
-        evaluate_phong(fit, s.n_dot_l, s.lobe_cos, predicted);
+        evaluate_phong(fit, s.d, s.lobe_cos, predicted);
         const float irradiance = light_irradiance_at(lights[s.raster], mesh.positions + 3 * v);
         for (float &c : predicted) c *= irradiance;
         const uint8_t own = masks.own_texels(s.raster, v);

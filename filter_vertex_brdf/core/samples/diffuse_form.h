@@ -1,0 +1,66 @@
+#pragma once
+// The diffuse term's form: the factor d that k_d C multiplies, f_c = k_d d C_c + specular.
+//   Lambert  d = N.L  (the thesis)
+//   Coated   d = N.L T(N.L) T(N.E) / T(1)^2: a diffuse body under a clear dielectric coat (varnish,
+//            glaze, wax, the plastic of most glossy objects). Light enters and leaves through the
+//            coat, so the body's light is scaled by the coat's Fresnel transmission T on the way in
+//            and on the way out (unpolarised Fresnel, refractive index kCoatIndex). Normalised so
+//            that d = N.L at normal incidence and exitance: k_d C is the albedo seen head-on.
+// Why: a Lambertian k_d has no exit-angle term, so a vertex that one camera sees at a grazing
+// angle gets a darker k_d than a camera facing it sees (spot: fitted/true albedo 0.77 at N.E < 0.1);
+// a second camera, or relighting from another view, then disagrees. Reciprocity makes the form
+// testable from one camera: T(N.L) on the light side is the same curve as T(N.E) on the view side.
+// Measured choice and figures: README "The diffuse term's form".
+//
+// Safeguards: N.E is clamped below at kCoatMinNdotE before T, so d never falls below
+// T(kCoatMinNdotE)/T(1) of the Lambert value on the view side (at grazing exitance the photos mix
+// the pixel's footprint and the vertex normal is least faithful: with the clamp at 0.2 the other
+// camera's error was lowest on the spot pair, 0.15-0.5 tried); d <= 0 exactly when N.L <= 0 (the
+// value is N.L there, unchanged, so attached-shadow tests and signed checks still hold); finite
+// for any finite input.
+//
+// Every stage takes d from diffuse_factor(): the gatherer stores it in Sample::d, so the CPU and GPU
+// fits, DQ/SQ, the material stage, coverage and the sample-based evaluation use the form without
+// knowing it; the relight renderer's shader and the live view evaluate the same expression (GLSL
+// copy in relight_render.cpp). The result stores it (per-vertex attribute diffuse_form, PLY
+// header comment).
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+namespace vbrdf {
+
+enum class DiffuseForm : uint8_t { Lambert = 0, Coated = 1 };
+
+constexpr float kCoatIndex = 1.5f;       // refractive index of the coat (varnishes, plastics: 1.45-1.55)
+constexpr float kCoatMinNdotE = 0.2f;    // N.E clamp on the view side (see the safeguards above)
+
+// "lambert" / "coated" (PLY comment, report, command-line value).
+inline const char *diffuse_form_name(DiffuseForm f) { return f == DiffuseForm::Coated ? "coated" : "lambert"; }
+
+// Parses diffuse_form_name() values; false if unknown.
+inline bool parse_diffuse_form(const std::string &text, DiffuseForm &out) {
+  if (text == "lambert") return out = DiffuseForm::Lambert, true;
+  if (text == "coated") return out = DiffuseForm::Coated, true;
+  return false;
+}
+
+// Unpolarised Fresnel transmission into a dielectric of index kCoatIndex at incidence cosine c
+// (clamped to [0, 1]): 1 - (r_s^2 + r_p^2) / 2. T(1) = 0.96, T(0) = 0.
+inline float coat_transmission(float c) {
+  c = std::fmin(std::fmax(c, 0.0f), 1.0f);
+  const float sin_t = std::sqrt(std::fmax(0.0f, 1.0f - c * c)) / kCoatIndex;
+  const float cos_t = std::sqrt(std::fmax(0.0f, 1.0f - sin_t * sin_t));
+  const float rs = (c - kCoatIndex * cos_t) / (c + kCoatIndex * cos_t);
+  const float rp = (kCoatIndex * c - cos_t) / (kCoatIndex * c + cos_t);
+  return 1.0f - 0.5f * (rs * rs + rp * rp);
+}
+
+// The diffuse factor d for the cosines N.L and N.E of unit vectors (see the header comment).
+inline float diffuse_factor(DiffuseForm f, float n_dot_l, float n_dot_e) {
+  if (f == DiffuseForm::Lambert || !(n_dot_l > 0)) return n_dot_l;
+  const float t1 = coat_transmission(1.0f);
+  return n_dot_l * coat_transmission(n_dot_l) * coat_transmission(std::fmax(n_dot_e, kCoatMinNdotE)) / (t1 * t1);
+}
+
+} // namespace vbrdf
