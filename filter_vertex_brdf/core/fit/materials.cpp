@@ -158,35 +158,58 @@ std::vector<double> alpha_grid(const PhongFitOptions &o) {
   return g;
 }
 
-// Pooled lobes of materials 1..K (label[v]) on `set`: alpha over a log grid with parabolic
-// refinement in ln alpha, k_s in closed form (rho eliminated per vertex).
+// The vertices the alpha grid search of fit_lobes looks at: every k-th labelled one, k such that
+// about kGridVertices remain (all of them on smaller meshes). A material's pooled lobe is an
+// average over its vertices, so an even subsample finds the same alpha; the chosen alpha is then
+// evaluated on every vertex. On the benchmark's 100 k vertices the stage took 7.3 s before, 4.7 s
+// with it (alpha of the main glossy material 84.9 -> 86.0); meshes under 8000 eligible vertices
+// are unchanged.
+constexpr size_t kGridVertices = 8000;
+std::vector<int32_t> grid_labels(const Context &c, const std::vector<int32_t> &label) {
+  size_t labelled = 0;
+  for (size_t v = 0; v < c.n; ++v) labelled += c.eligible[v] && label[v] > 0;
+  const size_t stride = (labelled + kGridVertices - 1) / kGridVertices;
+  if (stride <= 1) return label;
+  std::vector<int32_t> out(label.size(), 0);
+  for (size_t v = 0, k = 0; v < c.n; ++v)
+    if (c.eligible[v] && label[v] > 0 && k++ % stride == 0) out[v] = label[v];
+  return out;
+}
+
+// Pooled lobes of materials 1..K (label[v]) on `set`: alpha over a log grid (on grid_labels'
+// subsample) with parabolic refinement in ln alpha, k_s in closed form (rho eliminated per vertex);
+// the grid's best alpha and the refined one are then evaluated on every labelled vertex and the
+// better kept (energies, k_s: from every vertex; alpha_lo/hi: from the grid's subsample).
 std::vector<LobeFit> fit_lobes(const Context &c, int set, const std::vector<Static> &S, const std::vector<int32_t> &label,
                                int K) {
   const std::vector<double> grid = alpha_grid(c.o);
   std::vector<std::vector<double>> E(size_t(K) + 1, std::vector<double>(grid.size(), 0.0)), KS = E;
   std::vector<LobeFit> fit(size_t(K) + 1);
+  const std::vector<int32_t> sub_label = grid_labels(c, label);
+  const bool subsampled = sub_label != label;
   // k_s = 0 energies.
   for (size_t v = 0; v < c.n; ++v)
     if (c.eligible[v] && label[v] > 0) fit[size_t(label[v])].energy_zero += energy_ks(S[v], Lobe(), 0);
-  auto evaluate = [&](const std::vector<double> &alpha_of, std::vector<double> &ks_out, std::vector<double> &e_out) {
-    const std::vector<Lobe> L = lobe_sums(c, set, label, alpha_of);
+  auto evaluate = [&](const std::vector<int32_t> &which, const std::vector<double> &alpha_of, std::vector<double> &ks_out,
+                      std::vector<double> &e_out) {
+    const std::vector<Lobe> L = lobe_sums(c, set, which, alpha_of);
     std::vector<double> num(size_t(K) + 1, 0), den(size_t(K) + 1, 0);
     for (size_t v = 0; v < c.n; ++v) {
-      if (!c.eligible[v] || label[v] <= 0) continue;
+      if (!c.eligible[v] || which[v] <= 0) continue;
       double info, rhs;
       ks_equation(S[v], L[v], info, rhs);
-      num[size_t(label[v])] += rhs, den[size_t(label[v])] += info;
+      num[size_t(which[v])] += rhs, den[size_t(which[v])] += info;
     }
     ks_out.assign(size_t(K) + 1, 0);
     e_out.assign(size_t(K) + 1, 0);
     for (int m = 1; m <= K; ++m)
       ks_out[size_t(m)] = den[size_t(m)] > 0 ? std::min(std::max(num[size_t(m)] / den[size_t(m)], 0.0), double(c.o.ks_max)) : 0;
     for (size_t v = 0; v < c.n; ++v)
-      if (c.eligible[v] && label[v] > 0) e_out[size_t(label[v])] += energy_ks(S[v], L[v], ks_out[size_t(label[v])]);
+      if (c.eligible[v] && which[v] > 0) e_out[size_t(which[v])] += energy_ks(S[v], L[v], ks_out[size_t(which[v])]);
   };
   for (size_t i = 0; i < grid.size(); ++i) {
     std::vector<double> ks, e;
-    evaluate(std::vector<double>(size_t(K) + 1, grid[i]), ks, e);
+    evaluate(sub_label, std::vector<double>(size_t(K) + 1, grid[i]), ks, e);
     for (int m = 1; m <= K; ++m) E[size_t(m)][i] = e[size_t(m)], KS[size_t(m)][i] = ks[size_t(m)];
   }
   std::vector<double> refined(size_t(K) + 1, 1.0);
@@ -209,7 +232,13 @@ std::vector<LobeFit> fit_lobes(const Context &c, int set, const std::vector<Stat
     }
   }
   std::vector<double> ks, e;
-  evaluate(refined, ks, e);
+  if (subsampled) {  // the grid's best on every vertex, the reference the refined alpha must beat
+    std::vector<double> best_alpha(size_t(K) + 1, 1.0);
+    for (int m = 1; m <= K; ++m) best_alpha[size_t(m)] = fit[size_t(m)].alpha;
+    evaluate(label, best_alpha, ks, e);
+    for (int m = 1; m <= K; ++m) fit[size_t(m)].ks = ks[size_t(m)], fit[size_t(m)].energy = e[size_t(m)];
+  }
+  evaluate(label, refined, ks, e);
   for (int m = 1; m <= K; ++m)
     if (e[size_t(m)] < fit[size_t(m)].energy)
       fit[size_t(m)].alpha = refined[size_t(m)], fit[size_t(m)].ks = ks[size_t(m)], fit[size_t(m)].energy = e[size_t(m)];
