@@ -37,12 +37,14 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
 layout(location = 3) in vec2 a_ks_alpha;
+layout(location = 4) in float a_coated;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_rho_fitted;
 out vec2 v_ks_alpha;
+out float v_coated;
 out float v_depth;
 void main() {
   vec4 view_pos = u_view * vec4(a_position, 1.0);
@@ -50,6 +52,7 @@ void main() {
   v_normal = a_normal;
   v_rho_fitted = a_rho_fitted;
   v_ks_alpha = a_ks_alpha;
+  v_coated = a_coated;
   v_depth = -view_pos.z;
   gl_Position = u_projection * view_pos;
 }
@@ -63,11 +66,11 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec4 v_rho_fitted;
 in vec2 v_ks_alpha;
+in float v_coated;
 in float v_depth;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
 uniform int u_half_angle_lobe;
-uniform int u_coated_diffuse;
 uniform float u_coat_index;
 uniform float u_coat_min_n_dot_e;
 uniform mat4 u_light_view;
@@ -96,10 +99,12 @@ float coat_transmission(float c) {
   float rp = (u_coat_index * c - cos_t) / (u_coat_index * c + cos_t);
   return 1.0 - 0.5 * (rs * rs + rp * rp);
 }
-float diffuse_factor(float n_dot_l, float n_dot_e) {
-  if (u_coated_diffuse == 0 || !(n_dot_l > 0.0)) return n_dot_l;
+// Per vertex 1 coated, 0 Lambert (DiffuseForms), interpolated across a triangle that has both.
+float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
+  if (coated <= 0.0 || !(n_dot_l > 0.0)) return n_dot_l;
   float t1 = coat_transmission(1.0);
-  return n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
+  float coat = n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
+  return mix(n_dot_l, coat, min(coated, 1.0));
 }
 
 void main() {
@@ -135,11 +140,11 @@ void main() {
   float spec = 0.0;
   if (v_ks_alpha.x > 0.0 && s > 0.0)
     spec = v_ks_alpha.x * exp(max(v_ks_alpha.y * log(min(s, 1.0)), -80.0));
-  o_color = vec4((v_rho_fitted.rgb * diffuse_factor(d, dot(n, e)) + vec3(spec)) * irradiance, 1.0);
+  o_color = vec4((v_rho_fitted.rgb * diffuse_factor(d, dot(n, e), v_coated) + vec3(spec)) * irradiance, 1.0);
 }
 )";
 
-constexpr int kFloatsPerVertex = 12;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1
+constexpr int kFloatsPerVertex = 13;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, coated 1
 
 // The shininess given to k_s = 0 vertices (see the header): median of the fitted lobes.
 float typical_shininess(const std::vector<VertexFit> &fits) {
@@ -229,6 +234,7 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
     o[9] = f.status == kFitNone ? 0.0f : 1.0f;
     o[10] = f.ks;
     o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
+    o[12] = settings_.diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
   }
   index_count_ = mesh.index_count;
 
@@ -238,8 +244,8 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[4] = {3, 3, 4, 2}, offsets[4] = {0, 3, 6, 10};
-  for (GLuint a = 0; a < 4; ++a) {
+  const int sizes[5] = {3, 3, 4, 2, 1}, offsets[5] = {0, 3, 6, 10, 12};
+  for (GLuint a = 0; a < 5; ++a) {
     gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
                             reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
     gl_.EnableVertexAttribArray(a);
@@ -330,7 +336,6 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_half_angle_lobe"), settings_.lobe == LobeForm::BlinnNH ? 1 : 0);
-  gl_.Uniform1i(gl_.GetUniformLocation(p, "u_coated_diffuse"), settings_.diffuse == DiffuseForm::Coated ? 1 : 0);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_coat_index"), kCoatIndex);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_coat_min_n_dot_e"), kCoatMinNdotE);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
