@@ -1,0 +1,137 @@
+// "Vertex BRDF: relight" render plugin (render_vertex_brdf.h).
+#include "render_vertex_brdf.h"
+
+#include <QAction>
+
+#include <common/GLExtensionsManager.h>
+#include "meshlab/glarea.h"
+
+#include "core/base/errors.h"
+#include "core/relight/live_relight.h"
+#include "gl_view_state.h"
+#include "meshlab_bridge.h"
+#include "relight_attributes.h"
+#include "relight_panel.h"
+
+namespace {
+
+// One action per display mode (MeshLab lists them under Render > Shaders); data = LiveDisplay.
+const struct {
+  const char *text;
+  vbrdf::LiveDisplay display;
+} kModes[] = {
+    {"Vertex BRDF: relight", vbrdf::LiveDisplay::Full},
+    {"Vertex BRDF: relight, diffuse only", vbrdf::LiveDisplay::Diffuse},
+    {"Vertex BRDF: relight, specular only", vbrdf::LiveDisplay::Specular},
+    {"Vertex BRDF: fit_status colours", vbrdf::LiveDisplay::FitStatus},
+    {"Vertex BRDF: DQ colours", vbrdf::LiveDisplay::DiffuseQuality},
+    {"Vertex BRDF: SQ colours", vbrdf::LiveDisplay::SpecularQuality},
+};
+
+} // namespace
+
+RenderVertexBrdfPlugin::RenderVertexBrdfPlugin() = default;
+RenderVertexBrdfPlugin::~RenderVertexBrdfPlugin() = default;  // GL objects need the view's context: Finalize frees them
+
+QString RenderVertexBrdfPlugin::pluginName() const { return "RenderVertexBrdf"; }
+
+QList<QAction *> RenderVertexBrdfPlugin::actions() {
+  if (actions_.isEmpty())
+    for (const auto &m : kModes) {
+      auto *a = new QAction(m.text, this);
+      a->setData(int(m.display));
+      actions_ << a;
+    }
+  return actions_;
+}
+
+void RenderVertexBrdfPlugin::Init(QAction *action, MeshDocument &md, MLSceneGLSharedDataContext::PerMeshRenderingDataMap &,
+                                  GLArea *gla) {
+  gla->makeCurrent();
+  supported_ = GLExtensionsManager::initializeGLextensions_notThrowing() && GLEW_VERSION_3_3;
+  if (!supported_) {
+    md.Log.Log(GLLogStream::WARNING, "Vertex BRDF relight needs OpenGL 3.3.");
+    return;
+  }
+  if (panel_ == nullptr) panel_ = new vbrdf_render::RelightPanel(gla, [gla] { gla->update(); });
+  panel_->set_display(vbrdf::LiveDisplay(action->data().toInt()));
+  panel_->setWindowTitle(action->text());
+  panel_->move(10, 100);
+  panel_->show();
+  fingerprint_ = 0;  // re-read the model
+  mesh_id_ = -1;
+}
+
+bool RenderVertexBrdfPlugin::ensure_model(MeshModel &mesh, MeshDocument &md, GLArea *gla) {
+  const uint64_t fingerprint = vbrdf_plugin::relight_model_fingerprint(mesh);
+  if (mesh.id() == mesh_id_ && fingerprint == fingerprint_ && fingerprint != 0) return model_ok_;
+  if (mesh.id() == mesh_id_ && fingerprint == 0 && fingerprint_ == 0 && !model_ok_ && mesh_id_ != -1) return false;
+  live_.reset();
+  mesh_id_ = mesh.id();
+  fingerprint_ = fingerprint;
+  model_ok_ = false;
+  try {
+    const vbrdf_plugin::RelightModel model = vbrdf_plugin::relight_model(mesh);
+    const QGLContext *context = gla->context();
+    auto get_proc = [context](const char *name) -> void * {
+      return reinterpret_cast<void *>(context->getProcAddress(QString::fromLatin1(name)));
+    };
+    live_.reset(new vbrdf::LiveRelight(model.arrays.data.view(), model.fits, get_proc, model.lobe, model.diffuse));
+    model_ok_ = true;
+    const QString what = QString("Vertex BRDF relight: %1 vertices of '%2', %3 with a fit (lobe %4, diffuse %5).")
+                             .arg(model.fits.size())
+                             .arg(mesh.label())
+                             .arg(model.modelled)
+                             .arg(vbrdf::lobe_form_label(model.lobe))
+                             .arg(vbrdf::diffuse_form_name(model.diffuse));
+    md.Log.Log(GLLogStream::FILTER, qUtf8Printable(what));
+    if (panel_) panel_->set_message(what.mid(QString("Vertex BRDF relight: ").size()), false);
+  } catch (const std::exception &e) {  // InputError: no model; ProcessingError: GL
+    md.Log.Log(GLLogStream::WARNING, e.what());
+    if (panel_) panel_->set_message(QString::fromUtf8(e.what()), true);
+  }
+  return model_ok_;
+}
+
+void RenderVertexBrdfPlugin::Render(QAction *, MeshDocument &md, MLSceneGLSharedDataContext::PerMeshRenderingDataMap &,
+                                    GLArea *gla) {
+  if (gla == nullptr || gla->mvc() == nullptr) return;
+  MLSceneGLSharedDataContext *shared = gla->mvc()->sharedDataContext();
+  if (shared == nullptr) return;
+  MeshModel *current = md.mm();
+  for (MeshModel *mp : md.meshList) {
+    if (mp == nullptr || !gla->meshVisibilityMap[mp->id()]) continue;
+    if (mp == current && ensure_model(*mp, md, gla)) {
+      vbrdf::LiveView view = vbrdf_render::current_gl_view();
+      view.display = panel_ ? panel_->display() : vbrdf::LiveDisplay::Full;
+      view.exposure = panel_ ? panel_->exposure() : 1.0f;
+      try {
+        live_->draw(view);
+        continue;
+      } catch (const std::exception &e) {
+        md.Log.Log(GLLogStream::WARNING, e.what());
+        if (panel_) panel_->set_message(QString::fromUtf8(e.what()), true);
+      }
+    }
+    // MeshLab's normal rendering (other layers, or no model).
+    shared->setMeshTransformationMatrix(mp->id(), mp->cm.Tr);
+    shared->draw(mp->id(), gla->context());
+  }
+}
+
+void RenderVertexBrdfPlugin::Finalize(QAction *, MeshDocument *, GLArea *gla) {
+  if (gla) gla->makeCurrent();
+  release();
+}
+
+void RenderVertexBrdfPlugin::release() {
+  live_.reset();
+  mesh_id_ = -1;
+  fingerprint_ = 0;
+  model_ok_ = false;
+  if (panel_) {
+    panel_->close();
+    delete panel_;
+    panel_ = nullptr;
+  }
+}

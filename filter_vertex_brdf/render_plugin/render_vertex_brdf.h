@@ -1,0 +1,51 @@
+#pragma once
+// MeshLab 2020.09 render plugin "Vertex BRDF: relight" (Render > Shaders): draws the current mesh
+// with its per-vertex Phong model, lit by MeshLab's own light (Ctrl+Shift+drag). A thin adapter:
+// the model comes from the mesh's attributes (plugin/relight_attributes.h), the drawing from the
+// core (core/relight/live_relight.h), the view from GL state (gl_view_state.h), the controls from
+// relight_panel.h. Without a model it shows why and draws MeshLab's normal rendering.
+#include <cstdint>
+#include <memory>
+
+#include <GL/glew.h>
+#include <QObject>
+#include <common/interfaces.h>
+
+namespace vbrdf {
+class LiveRelight;
+}
+namespace vbrdf_render {
+class RelightPanel;
+}
+
+class RenderVertexBrdfPlugin : public QObject, public MeshRenderInterface {
+  Q_OBJECT
+  MESHLAB_PLUGIN_IID_EXPORTER(MESH_RENDER_INTERFACE_IID)
+  Q_INTERFACES(MeshRenderInterface)
+
+public:
+  RenderVertexBrdfPlugin();
+  ~RenderVertexBrdfPlugin() override;
+
+  QString pluginName() const override;
+  QList<QAction *> actions() override;
+  bool isSupported() override { return supported_; }
+  void Init(QAction *action, MeshDocument &md, MLSceneGLSharedDataContext::PerMeshRenderingDataMap &mp,
+            GLArea *gla) override;
+  void Render(QAction *action, MeshDocument &md, MLSceneGLSharedDataContext::PerMeshRenderingDataMap &mp,
+              GLArea *gla) override;
+  void Finalize(QAction *action, MeshDocument *md, GLArea *gla) override;
+
+private:
+  // True when `mesh`'s model is uploaded (re-read when its attributes changed).
+  bool ensure_model(MeshModel &mesh, MeshDocument &md, GLArea *gla);
+  void release();
+
+  QList<QAction *> actions_;
+  bool supported_ = false;
+  vbrdf_render::RelightPanel *panel_ = nullptr;
+  std::unique_ptr<vbrdf::LiveRelight> live_;
+  int mesh_id_ = -1;
+  uint64_t fingerprint_ = 0;  // of the uploaded model, or of the mesh whose model was missing
+  bool model_ok_ = false;
+};
