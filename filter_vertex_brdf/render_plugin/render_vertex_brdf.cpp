@@ -8,6 +8,7 @@
 
 #include "core/base/errors.h"
 #include "core/relight/live_relight.h"
+#include "core/relight/live_view_file.h"
 #include "gl_view_state.h"
 #include "meshlab_bridge.h"
 #include "relight_attributes.h"
@@ -93,6 +94,42 @@ bool RenderVertexBrdfPlugin::ensure_model(MeshModel &mesh, MeshDocument &md, GLA
   return model_ok_;
 }
 
+// MeshLab's normal rendering of one layer, as GLArea::paintEvent draws it without a render plugin
+// (its private setLightingColors copied: light colours from the view's settings, back-face culling).
+void RenderVertexBrdfPlugin::draw_as_meshlab_does(MLSceneGLSharedDataContext &shared, MeshModel &mesh, GLArea *gla) {
+  MLRenderingData data;
+  shared.getRenderInfoPerMeshView(mesh.id(), gla->context(), data);
+  MLPerViewGLOptions opts;
+  if (data.get(opts)) {
+    if (opts._double_side_lighting || opts._fancy_lighting) glEnable(GL_LIGHT1);
+    else glDisable(GL_LIGHT1);
+    const GLAreaSetting &s = gla->glas;
+    for (GLenum light : {GLenum(GL_LIGHT0), GLenum(GL_LIGHT1)}) {
+      glLightfv(light, GL_AMBIENT, vcg::Color4f::Construct(s.baseLightAmbientColor).V());
+      glLightfv(light, GL_DIFFUSE, vcg::Color4f::Construct(s.baseLightDiffuseColor).V());
+      glLightfv(light, GL_SPECULAR, vcg::Color4f::Construct(s.baseLightSpecularColor).V());
+    }
+    if (opts._fancy_lighting) {
+      glLightfv(GL_LIGHT0, GL_DIFFUSE, vcg::Color4f::Construct(s.fancyFLightDiffuseColor).V());
+      glLightfv(GL_LIGHT1, GL_DIFFUSE, vcg::Color4f::Construct(s.fancyBLightDiffuseColor).V());
+    }
+    if (opts._back_face_cull) glEnable(GL_CULL_FACE);
+    else glDisable(GL_CULL_FACE);
+  }
+  shared.setMeshTransformationMatrix(mesh.id(), mesh.cm.Tr);
+  shared.draw(mesh.id(), gla->context());
+}
+
+// For the GUI test (tests/gui): the drawn view, when VBRDF_RELIGHT_VIEW_LOG names a file.
+void RenderVertexBrdfPlugin::log_view(const vbrdf::LiveView &view) {
+  const QByteArray path = qgetenv("VBRDF_RELIGHT_VIEW_LOG");
+  if (path.isEmpty()) return;
+  vbrdf::LiveViewRecord record;
+  record.view = view;
+  glGetIntegerv(GL_VIEWPORT, record.viewport);
+  vbrdf::write_live_view(path.toStdString(), record);
+}
+
 void RenderVertexBrdfPlugin::Render(QAction *, MeshDocument &md, MLSceneGLSharedDataContext::PerMeshRenderingDataMap &,
                                     GLArea *gla) {
   if (gla == nullptr || gla->mvc() == nullptr) return;
@@ -107,15 +144,14 @@ void RenderVertexBrdfPlugin::Render(QAction *, MeshDocument &md, MLSceneGLShared
       view.exposure = panel_ ? panel_->exposure() : 1.0f;
       try {
         live_->draw(view);
+        log_view(view);
         continue;
       } catch (const std::exception &e) {
         md.Log.Log(GLLogStream::WARNING, e.what());
         if (panel_) panel_->set_message(QString::fromUtf8(e.what()), true);
       }
     }
-    // MeshLab's normal rendering (other layers, or no model).
-    shared->setMeshTransformationMatrix(mp->id(), mp->cm.Tr);
-    shared->draw(mp->id(), gla->context());
+    draw_as_meshlab_does(*shared, *mp, gla);  // other layers, or no model
   }
 }
 

@@ -13,6 +13,7 @@
 
 namespace vbrdf {
 class LiveRelight;
+struct LiveView;
 }
 namespace vbrdf_render {
 class RelightPanel;
@@ -40,6 +41,8 @@ private:
   // True when `mesh`'s model is uploaded (re-read when its attributes changed).
   bool ensure_model(MeshModel &mesh, MeshDocument &md, GLArea *gla);
   void release();
+  void log_view(const vbrdf::LiveView &view);
+  static void draw_as_meshlab_does(MLSceneGLSharedDataContext &shared, MeshModel &mesh, GLArea *gla);
 
   QList<QAction *> actions_;
   bool supported_ = false;
