@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include <QCheckBox>
 #include <QLabel>
 #include <QSlider>
 #include <QVBoxLayout>
@@ -52,12 +53,19 @@ RelightPanel::RelightPanel(QWidget *parent, std::function<void()> changed)
   exposure_->setRange(-16, 16);
   exposure_->setValue(0);
   exposure_->setToolTip("Multiplies the model's linear value before clipping at 1 and sRGB encoding.");
+  lights_ = new QCheckBox("Photo lights on a sphere", body);
+  lights_->setChecked(true);
+  lights_->setToolTip("Yellow: the light directions of the project's photos; orange: MeshLab's light now.");
+  lights_note_ = new QLabel(body);
+  lights_note_->setWordWrap(true);
   legend_ = new QLabel(body);
   legend_->setTextFormat(Qt::RichText);
   message_ = new QLabel(body);
   message_->setWordWrap(true);
   layout->addWidget(exposure_label_);
   layout->addWidget(exposure_);
+  layout->addWidget(lights_);
+  layout->addWidget(lights_note_);
   layout->addWidget(legend_);
   layout->addWidget(message_);
   layout->addStretch(1);
@@ -68,11 +76,15 @@ RelightPanel::RelightPanel(QWidget *parent, std::function<void()> changed)
     update_label();
     if (changed_) changed_();
   });
+  connect(lights_, &QCheckBox::toggled, this, [this] {
+    if (changed_) changed_();
+  });
   set_display(display_);
   set_message("", false);
+  set_lights_note("");
   setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
   setFloating(true);
-  resize(280, 300);
+  resize(300, 340);
 }
 
 void RelightPanel::set_display(vbrdf::LiveDisplay display) {
@@ -84,6 +96,13 @@ void RelightPanel::set_display(vbrdf::LiveDisplay display) {
 }
 
 float RelightPanel::exposure() const { return std::exp2(float(exposure_->value()) / 4.0f); }
+
+bool RelightPanel::show_lights() const { return lights_->isChecked(); }
+
+void RelightPanel::set_lights_note(const QString &text) {
+  lights_note_->setText(text);
+  lights_note_->setVisible(!text.isEmpty());
+}
 
 void RelightPanel::set_message(const QString &text, bool warning) {
   message_->setText(text);

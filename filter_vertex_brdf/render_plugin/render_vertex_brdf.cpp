@@ -10,6 +10,8 @@
 #include "core/relight/live_relight.h"
 #include "core/relight/live_view_file.h"
 #include "gl_view_state.h"
+#include "light_sphere.h"
+#include "photo_lights.h"
 #include "meshlab_bridge.h"
 #include "relight_attributes.h"
 #include "relight_panel.h"
@@ -79,6 +81,7 @@ bool RenderVertexBrdfPlugin::ensure_model(MeshModel &mesh, MeshDocument &md, GLA
     };
     live_.reset(new vbrdf::LiveRelight(model.arrays.data.view(), model.fits, get_proc, model.lobe, model.diffuse));
     model_ok_ = true;
+    load_photo_lights(md, mesh, model.arrays);
     const QString what = QString("Vertex BRDF relight: %1 vertices of '%2', %3 with a fit (lobe %4, diffuse %5).")
                              .arg(model.fits.size())
                              .arg(mesh.label())
@@ -92,6 +95,25 @@ bool RenderVertexBrdfPlugin::ensure_model(MeshModel &mesh, MeshDocument &md, GLA
     if (panel_) panel_->set_message(QString::fromUtf8(e.what()), true);
   }
   return model_ok_;
+}
+
+// The light sphere: centred on the mesh's bounding box, 1.1 times its half diagonal; the photo
+// lights when the project has a light file (else the panel says why; the sphere then shows only
+// MeshLab's light).
+void RenderVertexBrdfPlugin::load_photo_lights(MeshDocument &md, MeshModel &mesh, const vbrdf_plugin::MeshArrays &arrays) {
+  const vbrdf::Bounds box = vbrdf::compute_bounds(arrays.data.view());
+  sphere_centre_ = box.centre();
+  sphere_radius_ = 0.55f * box.diagonal();
+  photo_lights_.clear();
+  if (panel_ == nullptr) return;
+  try {
+    const vbrdf_plugin::PhotoLights lights = vbrdf_plugin::photo_lights(md, mesh, arrays);
+    photo_lights_ = lights.directions;
+    panel_->set_lights_note(QString("%1 photo lights from %2").arg(photo_lights_.size())
+                                .arg(QString::fromStdString(lights.file).section('/', -1)));
+  } catch (const std::exception &e) {
+    panel_->set_lights_note(QString::fromUtf8(e.what()));
+  }
 }
 
 // MeshLab's normal rendering of one layer, as GLArea::paintEvent draws it without a render plugin
@@ -145,6 +167,12 @@ void RenderVertexBrdfPlugin::Render(QAction *, MeshDocument &md, MLSceneGLShared
       try {
         live_->draw(view);
         log_view(view);
+        const double eye_light[3] = {view.light_eye[0], view.light_eye[1], view.light_eye[2]};
+        double world[3];
+        if (panel_ && panel_->show_lights() && sphere_radius_ > 0 && view.light_eye[3] == 0.0f &&
+            vbrdf::eye_to_world_direction(view.modelview, eye_light, world))
+          vbrdf_render::draw_light_sphere(sphere_centre_, sphere_radius_, photo_lights_,
+                                          {{float(world[0]), float(world[1]), float(world[2])}});
         continue;
       } catch (const std::exception &e) {
         md.Log.Log(GLLogStream::WARNING, e.what());

@@ -4,8 +4,10 @@
 // the model comes from the mesh's attributes (plugin/relight_attributes.h), the drawing from the
 // core (core/relight/live_relight.h), the view from GL state (gl_view_state.h), the controls from
 // relight_panel.h. Without a model it shows why and draws MeshLab's normal rendering.
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <GL/glew.h>
 #include <QObject>
@@ -17,6 +19,9 @@ struct LiveView;
 }
 namespace vbrdf_render {
 class RelightPanel;
+}
+namespace vbrdf_plugin {
+struct MeshArrays;
 }
 
 class RenderVertexBrdfPlugin : public QObject, public MeshRenderInterface {
@@ -42,6 +47,7 @@ private:
   bool ensure_model(MeshModel &mesh, MeshDocument &md, GLArea *gla);
   void release();
   void log_view(const vbrdf::LiveView &view);
+  void load_photo_lights(MeshDocument &md, MeshModel &mesh, const vbrdf_plugin::MeshArrays &arrays);
   static void draw_as_meshlab_does(MLSceneGLSharedDataContext &shared, MeshModel &mesh, GLArea *gla);
 
   QList<QAction *> actions_;
@@ -51,4 +57,7 @@ private:
   int mesh_id_ = -1;
   uint64_t fingerprint_ = 0;  // of the uploaded model, or of the mesh whose model was missing
   bool model_ok_ = false;
+  std::vector<std::array<float, 3>> photo_lights_;  // world directions (light sphere)
+  std::array<float, 3> sphere_centre_{{0, 0, 0}};
+  float sphere_radius_ = 0;
 };

@@ -10,8 +10,8 @@
 // Environment (VBRDF_GUI_FILTER or VBRDF_GUI_RENDER needed, the rest optional):
 //   VBRDF_GUI_FILTER  the menu entry (filter name) to open
 //   VBRDF_GUI_RENDER  the render mode (Render > Shaders entry) to switch on after the filter ran
-//                     (or at once without VBRDF_GUI_FILTER); screenshots render_window.png and
-//                     view.png (the 3-D view only), copies of VBRDF_RELIGHT_VIEW_LOG beside them
+//                     (or at once without VBRDF_GUI_FILTER); screenshots (render_stage below) and
+//                     copies of VBRDF_RELIGHT_VIEW_LOG beside them
 //   VBRDF_GUI_LIGHT_DRAG  "dx,dy": then a Ctrl+Shift+drag by that many pixels from the view's
 //                     centre, and view_moved.png, render_window_moved.png, view_moved.txt
 //   VBRDF_GUI_TYPE    "label=text" entries separated by newlines: text typed into the field
@@ -25,6 +25,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QCheckBox>
 #include <QCoreApplication>
 #include <QDir>
 #include <QDockWidget>
@@ -181,8 +182,18 @@ void drag_light(QWidget *view, int dx, int dy) {
   QApplication::sendEvent(view, &release);
 }
 
-// Switches on the render mode VBRDF_GUI_RENDER, takes the screenshots, drags the light if asked
-// (VBRDF_GUI_LIGHT_DRAG), takes them again and exits.
+// Sets every visible check box labelled `text` (e.g. the render plugin's "Photo lights on a sphere").
+void set_check_box(const QString &text, bool on) {
+  for (QWidget *w : QApplication::allWidgets())
+    if (auto *box = qobject_cast<QCheckBox *>(w))
+      if (box->isVisible() && box->text() == text) box->setChecked(on);
+}
+
+// Switches on the render mode VBRDF_GUI_RENDER and takes screenshots: the window as it comes up
+// (render_window.png); then, with the plugin's light sphere switched off so that only the model
+// and MeshLab's own overlays are in the view, the view (view.png); after a light drag
+// (VBRDF_GUI_LIGHT_DRAG) the view again (view_moved.png) and, with the sphere back on, the
+// window (render_window_moved.png). Then exits.
 void render_stage(QMainWindow *window) {
   const QString mode = env("VBRDF_GUI_RENDER");
   QAction *action = nullptr;
@@ -196,7 +207,8 @@ void render_stage(QMainWindow *window) {
   shot(gl_view(window), "view_before.png");  // MeshLab's own rendering of the same view
   action->trigger();
   report("render_mode", mode);
-  QTimer::singleShot(2500, window, [window] {
+  const QString sphere = "Photo lights on a sphere";
+  QTimer::singleShot(2500, window, [window, sphere] {
     report_log(window);
     QWidget *view = gl_view(window);
     if (view == nullptr) {
@@ -210,17 +222,23 @@ void render_stage(QMainWindow *window) {
         report("panel_rect", QString("%1,%2,%3,%4").arg(at.x()).arg(at.y()).arg(w->frameGeometry().width()).arg(w->frameGeometry().height()));
       }
     shot(window, "render_window.png");
-    shot(view, "view.png");
-    keep_view_log("view.txt");
-    const QStringList drag = env("VBRDF_GUI_LIGHT_DRAG").split(',');
-    if (drag.size() != 2) finish(0);
-    drag_light(view, drag[0].toInt(), drag[1].toInt());
-    report("light_dragged", drag.join(","));
-    QTimer::singleShot(2500, window, [window, view] {
-      shot(view, "view_moved.png");
-      shot(window, "render_window_moved.png");
-      keep_view_log("view_moved.txt");
-      finish(0);
+    set_check_box(sphere, false);
+    QTimer::singleShot(1500, window, [window, view, sphere] {
+      shot(view, "view.png");
+      keep_view_log("view.txt");
+      const QStringList drag = env("VBRDF_GUI_LIGHT_DRAG").split(',');
+      if (drag.size() != 2) finish(0);
+      drag_light(view, drag[0].toInt(), drag[1].toInt());
+      report("light_dragged", drag.join(","));
+      QTimer::singleShot(2500, window, [window, view, sphere] {
+        shot(view, "view_moved.png");
+        keep_view_log("view_moved.txt");
+        set_check_box(sphere, true);
+        QTimer::singleShot(1500, window, [window] {
+          shot(window, "render_window_moved.png");
+          finish(0);
+        });
+      });
     });
   });
 }

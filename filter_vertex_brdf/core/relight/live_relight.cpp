@@ -132,13 +132,20 @@ bool normalise(double v[3]) {
 
 } // namespace
 
+bool eye_to_world_direction(const double modelview[16], const double eye_direction[3], double world_out[3]) {
+  double inv[9];
+  if (!invert_linear_part(modelview, inv)) return false;
+  apply3(inv, eye_direction, world_out);
+  return normalise(world_out);
+}
+
 class LiveRelight::Impl {
 public:
   Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc, LobeForm lobe,
        DiffuseForm diffuse);
   ~Impl() { release(); }
   void draw(const LiveView &view);
-  std::vector<float> render_offscreen(const LiveView &view, int width, int height);
+  std::vector<float> render_offscreen(const LiveView &view, int width, int height, bool read_back);
   size_t vertex_count = 0;
 
 private:
@@ -233,8 +240,8 @@ void LiveRelight::Impl::draw(const LiveView &view) {
     for (int k = 0; k < 3; ++k) rel[k] = l_eye[k] / double(view.light_eye[3]) - view.modelview[12 + k];
     apply3(inv, rel, light);
     for (int k = 0; k < 3; ++k) light[k] -= origin_[k];
-  } else {
-    apply3(inv, l_eye, light);
+  } else if (!eye_to_world_direction(view.modelview, l_eye, light)) {
+    light[0] = light[1] = light[2] = 0;
   }
   if (!normalise(light)) throw InputError("Live relighting: the light direction is zero or not finite.");
   // The eye: the camera centre (perspective), or the direction towards the viewer (orthographic).
@@ -246,8 +253,7 @@ void LiveRelight::Impl::draw(const LiveView &view) {
     for (int k = 0; k < 3; ++k) eye[k] -= origin_[k];
   } else {
     const double back[3] = {0, 0, 1};
-    apply3(inv, back, eye);
-    normalise(eye);
+    eye_to_world_direction(view.modelview, back, eye);
   }
   // Modelview on recentred positions: M T(origin), the translation in double.
   float mv[16], proj[16];
@@ -284,7 +290,7 @@ void LiveRelight::Impl::draw(const LiveView &view) {
   check_gl_error(gl_, "the live relighting pass");
 }
 
-std::vector<float> LiveRelight::Impl::render_offscreen(const LiveView &view, int width, int height) {
+std::vector<float> LiveRelight::Impl::render_offscreen(const LiveView &view, int width, int height, bool read_back) {
   GlStateGuard guard(gl_);
   ensure_render_target(gl_, target_, width, height, RenderTargetKind::ShadingAndDepth, kWho, "the off-screen view");
   gl_.BindFramebuffer(GL_FRAMEBUFFER, target_.fbo);
@@ -294,6 +300,10 @@ std::vector<float> LiveRelight::Impl::render_offscreen(const LiveView &view, int
   gl_.ClearBufferfv(GL_COLOR, 0, zero);
   gl_.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
   draw(view);
+  if (!read_back) {
+    gl_.Finish();
+    return {};
+  }
   const size_t n = size_t(width) * size_t(height);
   std::vector<float> rgba(4 * n), out(4 * n);
   gl_.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
@@ -314,8 +324,8 @@ LiveRelight::LiveRelight(const MeshView &mesh, const std::vector<VertexFit> &fit
     : impl_(new Impl(mesh, fits, get_proc, lobe, diffuse)) {}
 LiveRelight::~LiveRelight() = default;
 void LiveRelight::draw(const LiveView &view) { impl_->draw(view); }
-std::vector<float> LiveRelight::render_offscreen(const LiveView &view, int width, int height) {
-  return impl_->render_offscreen(view, width, height);
+std::vector<float> LiveRelight::render_offscreen(const LiveView &view, int width, int height, bool read_back) {
+  return impl_->render_offscreen(view, width, height, read_back);
 }
 size_t LiveRelight::vertex_count() const { return impl_->vertex_count; }
 

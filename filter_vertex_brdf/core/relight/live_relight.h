@@ -43,6 +43,11 @@ struct LiveView {
   bool encode_srgb = true;  // false: linear output, unclipped (tests compare with the relight renderer)
 };
 
+// A direction given in eye coordinates (e.g. MeshLab's directional light) in world coordinates:
+// the inverse of the modelview's linear part applied, normalised. False when that part is singular
+// or the result is zero or not finite.
+bool eye_to_world_direction(const double modelview[16], const double eye_direction[3], double world_out[3]);
+
 class LiveRelight {
 public:
   // Uploads the mesh (positions relative to its bounding-box centre, for precision) and one
@@ -62,8 +67,9 @@ public:
   void draw(const LiveView &view);
 
   // Draws into an off-screen float target of width x height (cleared to 0) and reads it back:
-  // RGBA, row 0 = top; alpha 1 on the surface, 0 on the background. For tests and benchmarks.
-  std::vector<float> render_offscreen(const LiveView &view, int width, int height);
+  // RGBA, row 0 = top; alpha 1 on the surface, 0 on the background. For tests and benchmarks;
+  // read_back = false waits for the frame (glFinish) and returns nothing (frame timing).
+  std::vector<float> render_offscreen(const LiveView &view, int width, int height, bool read_back = true);
 
   size_t vertex_count() const;
 
