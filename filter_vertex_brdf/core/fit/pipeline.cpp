@@ -146,10 +146,16 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
     result.diffuse_choice_note = std::string(diffuse_form_name(result.diffuse_form)) +
                                  (settings.fit_reflectance ? " (as set)" : " (no Phong fit: the thesis's form)");
   } else {
+    const size_t loads_before = photos.loads();
     const DiffuseChoice choice =
         choose_diffuse_form(input.mesh, input.rasters, lights, masks, settings.gather, settings.phong, photos, prepare);
+    const size_t decoded_again = photos.loads() - loads_before;
     result.diffuse_form = choice.form;
-    result.diffuse_choice_note = choice.note + (choice.piloted ? ", " + fixed(choice.seconds) + " s" : "");
+    result.diffuse_choice_note = choice.note + (choice.piloted ? ", " + fixed(choice.seconds) + " s" : "") +
+                                 (decoded_again ? ", " + std::to_string(decoded_again) +
+                                                      " photo decodes (the photos exceed 'Photo memory (MB)'; "
+                                                      "set 'Diffuse term' to skip the pilot)"
+                                                : "");
     log("Vertex BRDF: diffuse term " + result.diffuse_choice_note + ".");
   }
   settings.phong.diffuse = settings.gather.diffuse = result.diffuse_form;
