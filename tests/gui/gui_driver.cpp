@@ -4,8 +4,16 @@
 // Apply, answers any message box, takes screenshots of the window and exits. It knows nothing of
 // the plugin: run_gui_e2e.py checks what the filter did with the typed values.
 //
-// Environment (all but VBRDF_GUI_FILTER optional):
+// Then, optionally, it switches on a render plugin's mode from Render > Shaders, moves MeshLab's
+// light as a user does (Ctrl+Shift+drag in the view) and takes screenshots of the 3-D view.
+//
+// Environment (VBRDF_GUI_FILTER or VBRDF_GUI_RENDER needed, the rest optional):
 //   VBRDF_GUI_FILTER  the menu entry (filter name) to open
+//   VBRDF_GUI_RENDER  the render mode (Render > Shaders entry) to switch on after the filter ran
+//                     (or at once without VBRDF_GUI_FILTER); screenshots (render_stage below) and
+//                     copies of VBRDF_RELIGHT_VIEW_LOG beside them
+//   VBRDF_GUI_LIGHT_DRAG  "dx,dy": then a Ctrl+Shift+drag by that many pixels from the view's
+//                     centre, and view_moved.png, render_window_moved.png, view_moved.txt
 //   VBRDF_GUI_TYPE    "label=text" entries separated by newlines: text typed into the field
 //   VBRDF_GUI_SHOTS   folder for screenshots (window.png, dialog.png, after.png)
 //   VBRDF_GUI_LOG     file the driver reports to (one "key: value" per line)
@@ -17,6 +25,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QCheckBox>
 #include <QCoreApplication>
 #include <QDir>
 #include <QDockWidget>
@@ -29,6 +38,7 @@
 #include <QMenu>
 #include <QScreen>
 #include <QMessageBox>
+#include <QMouseEvent>
 #include <QPushButton>
 #include <QTextStream>
 #include <QTimer>
@@ -140,6 +150,99 @@ void report_log(QMainWindow *window) {
   }
 }
 
+// MeshLab's 3-D view (class GLArea, a QGLWidget) of the main window.
+QWidget *gl_view(QMainWindow *window) {
+  for (QWidget *w : window->findChildren<QWidget *>())
+    if (w->inherits("GLArea") && w->isVisible()) return w;
+  return nullptr;
+}
+
+// Copies the render plugin's view log (VBRDF_RELIGHT_VIEW_LOG) beside the screenshots as `name`.
+void keep_view_log(const QString &name) {
+  const QString log = env("VBRDF_RELIGHT_VIEW_LOG"), dir = env("VBRDF_GUI_SHOTS");
+  if (log.isEmpty() || dir.isEmpty()) return;
+  const QString to = QDir(dir).filePath(name);
+  QFile::remove(to);
+  report("view_log", QFile::copy(log, to) ? to : "MISSING " + log);
+}
+
+// A Ctrl+Shift+left-button drag from the view's centre (MeshLab's light trackball).
+void drag_light(QWidget *view, int dx, int dy) {
+  const Qt::KeyboardModifiers mods = Qt::ControlModifier | Qt::ShiftModifier;
+  const QPoint from(view->width() / 2, view->height() / 2);
+  QMouseEvent press(QEvent::MouseButtonPress, from, Qt::LeftButton, Qt::LeftButton, mods);
+  QApplication::sendEvent(view, &press);
+  const int steps = 10;
+  for (int i = 1; i <= steps; ++i) {
+    QMouseEvent move(QEvent::MouseMove, from + QPoint(dx * i / steps, dy * i / steps), Qt::NoButton, Qt::LeftButton, mods);
+    QApplication::sendEvent(view, &move);
+    QApplication::processEvents();
+  }
+  QMouseEvent release(QEvent::MouseButtonRelease, from + QPoint(dx, dy), Qt::LeftButton, Qt::NoButton, mods);
+  QApplication::sendEvent(view, &release);
+}
+
+// Sets every visible check box labelled `text` (e.g. the render plugin's "Photo lights on a sphere").
+void set_check_box(const QString &text, bool on) {
+  for (QWidget *w : QApplication::allWidgets())
+    if (auto *box = qobject_cast<QCheckBox *>(w))
+      if (box->isVisible() && box->text() == text) box->setChecked(on);
+}
+
+// Switches on the render mode VBRDF_GUI_RENDER and takes screenshots: the window as it comes up
+// (render_window.png); then, with the plugin's light sphere switched off so that only the model
+// and MeshLab's own overlays are in the view, the view (view.png); after a light drag
+// (VBRDF_GUI_LIGHT_DRAG) the view again (view_moved.png) and, with the sphere back on, the
+// window (render_window_moved.png). Then exits.
+void render_stage(QMainWindow *window) {
+  const QString mode = env("VBRDF_GUI_RENDER");
+  QAction *action = nullptr;
+  for (QMenu *menu : window->findChildren<QMenu *>())
+    for (QAction *a : menu->actions())
+      if (a->text() == mode) action = a;
+  if (action == nullptr) {
+    report("error", "no render mode '" + mode + "' in the menus (render plugin not loaded?)");
+    finish(2);
+  }
+  shot(gl_view(window), "view_before.png");  // MeshLab's own rendering of the same view
+  action->trigger();
+  report("render_mode", mode);
+  const QString sphere = "Photo lights on a sphere";
+  QTimer::singleShot(2500, window, [window, sphere] {
+    report_log(window);
+    QWidget *view = gl_view(window);
+    if (view == nullptr) {
+      report("error", "no 3-D view");
+      finish(2);
+    }
+    report("view_size", QString::number(view->width()) + "x" + QString::number(view->height()));
+    for (QWidget *w : QApplication::allWidgets())  // the render plugin's panel, in view coordinates
+      if (w->objectName() == "VertexBrdfRelightPanel" && w->isVisible()) {
+        const QPoint at = view->mapFromGlobal(w->mapToGlobal(QPoint(0, 0)));
+        report("panel_rect", QString("%1,%2,%3,%4").arg(at.x()).arg(at.y()).arg(w->frameGeometry().width()).arg(w->frameGeometry().height()));
+      }
+    shot(window, "render_window.png");
+    set_check_box(sphere, false);
+    QTimer::singleShot(1500, window, [window, view, sphere] {
+      shot(view, "view.png");
+      keep_view_log("view.txt");
+      const QStringList drag = env("VBRDF_GUI_LIGHT_DRAG").split(',');
+      if (drag.size() != 2) finish(0);
+      drag_light(view, drag[0].toInt(), drag[1].toInt());
+      report("light_dragged", drag.join(","));
+      QTimer::singleShot(2500, window, [window, view, sphere] {
+        shot(view, "view_moved.png");
+        keep_view_log("view_moved.txt");
+        set_check_box(sphere, true);
+        QTimer::singleShot(1500, window, [window] {
+          shot(window, "render_window_moved.png");
+          finish(0);
+        });
+      });
+    });
+  });
+}
+
 class Driver : public QObject {
 public:
   Driver() {
@@ -168,6 +271,11 @@ private:
       }
       if (++settle_ < 10) return;  // let the project finish loading and drawing
       shot(window, "window.png");
+      if (filter.isEmpty()) {  // render mode only
+        stage_ = Stage::Done;
+        render_stage(window);
+        return;
+      }
       // Filter actions belong to their plugins; the window holds them in its menus.
       QAction *action = nullptr;
       for (QMenu *menu : window->findChildren<QMenu *>())
@@ -218,7 +326,12 @@ private:
         report_log(window);
         QTimer::singleShot(1500, this, [window] {
           shot(window, "after.png");
-          finish(0);
+          if (env("VBRDF_GUI_RENDER").isEmpty()) finish(0);
+          for (QDockWidget *d : window->findChildren<QDockWidget *>())  // the filter's dialog covers the view
+            if (d->isVisible() && d->windowTitle() == env("VBRDF_GUI_FILTER"))
+              for (QPushButton *b : d->findChildren<QPushButton *>())
+                if (b->text() == "Close") b->click();
+          QTimer::singleShot(1000, window, [window] { render_stage(window); });
         });
       });
     }
@@ -236,7 +349,7 @@ private:
 };
 
 void start_driver() {
-  if (env("VBRDF_GUI_FILTER").isEmpty()) return;
+  if (env("VBRDF_GUI_FILTER").isEmpty() && env("VBRDF_GUI_RENDER").isEmpty()) return;
   // After the constructor of QApplication: the main window comes later, inside exec().
   QTimer::singleShot(0, [] { new Driver(); });
 }

@@ -4,12 +4,18 @@
 
   run_gui_e2e.py typed-paths --project P.mlp --meshlab M --lib-dir L --driver D --workdir W
   run_gui_e2e.py dialogs     --project P.mlp --meshlab M --lib-dir L --driver D --workdir W
+  run_gui_e2e.py live-relight --project P.mlp --check C ...   (and live-relight-no-model)
 
 typed-paths: a copy of the project without any light file beside it or its photos; the fit dialog
 gets a typed light file (in a folder the default search never looks in, with a space in its name)
 and a typed output PLY. Passes only if the fit read the one and wrote the other, and wrote nothing
 at the default output path. dialogs: every Vertex BRDF dialog opens from its menu; their sizes
 are printed and screenshots kept in W/<filter>/.
+live-relight (issue 14): on a copy of the project the fit is applied, the render mode "Vertex BRDF:
+relight" switched on and the light moved (Ctrl+Shift+drag); both screenshots of the 3-D view must
+match the relight renderer's image of the logged view and light (C = vbrdf_live_view_check), and
+the light must have moved. live-relight-no-model: the render mode on the mesh without a fit must
+log the message and draw what MeshLab draws.
 Everything is written under --workdir; the project is only read.
 """
 import argparse
@@ -30,7 +36,7 @@ FILTERS = [FIT, "Vertex BRDF: coverage and next light", "Vertex BRDF: relight an
 SCREEN = (1280, 1024)
 
 
-def run_gui(a, project, filter_name, typed, shots, apply=True, timeout=600):
+def run_gui(a, project, filter_name, typed, shots, apply=True, timeout=600, extra_env=None):
     """Runs the GUI on `project` with the driver; returns (exit status, driver report lines)."""
     report = os.path.join(shots, "driver.txt")
     os.makedirs(shots, exist_ok=True)
@@ -43,6 +49,7 @@ def run_gui(a, project, filter_name, typed, shots, apply=True, timeout=600):
                LD_PRELOAD=os.path.abspath(a.driver), VBRDF_GUI_FILTER=filter_name,
                VBRDF_GUI_TYPE="\n".join(f"{k}={v}" for k, v in typed.items()), VBRDF_GUI_SHOTS=shots,
                VBRDF_GUI_LOG=report, VBRDF_GUI_APPLY="1" if apply else "0", LIBGL_ALWAYS_SOFTWARE="1")
+    env.update(extra_env or {})
     cmd = ["xvfb-run", "-a", "-s", f"-screen 0 {SCREEN[0]}x{SCREEN[1]}x24", a.meshlab, os.path.abspath(project)]
     print("running:", " ".join(cmd), flush=True)
     try:
@@ -137,17 +144,97 @@ def cmd_dialogs(a):
     return 0
 
 
+RELIGHT = "Vertex BRDF: relight"
+
+
+def cmd_live_relight(a):
+    shutil.rmtree(a.workdir, ignore_errors=True)
+    os.makedirs(a.workdir)
+    src_dir = os.path.dirname(os.path.abspath(a.project))
+    project_dir = os.path.join(a.workdir, "project")
+    shutil.copytree(src_dir, project_dir, ignore=shutil.ignore_patterns("heldout", "ground_truth", "*_brdf*"))
+    project = os.path.join(project_dir, os.path.basename(a.project))
+    result = os.path.join(project_dir, os.path.splitext(os.path.basename(a.project))[0] + "_brdf.ply")
+    shots = os.path.join(a.workdir, "shots")
+    rc, lines = run_gui(a, project, FIT, {}, shots, extra_env={
+        "VBRDF_GUI_RENDER": RELIGHT, "VBRDF_GUI_LIGHT_DRAG": "150,-100",
+        "VBRDF_RELIGHT_VIEW_LOG": os.path.join(a.workdir, "view_log.txt")})
+    failures = []
+    if rc != 0:
+        failures.append(f"meshlab/driver exit status {rc}")
+    for box in values(lines, "message_box"):
+        failures.append(f"MeshLab reported: {box}")
+    if values(lines, "render_mode") != [RELIGHT]:
+        failures.append("the render mode was not switched on")
+    if not any("Vertex BRDF relight:" in l and "vertices of" in l for l in values(lines, "log")):
+        failures.append("the log does not report the model the live view drew")
+    views = [os.path.join(shots, n) for n in ("view.txt", "view_moved.txt")]
+    if not all(os.path.isfile(v) for v in views):
+        failures.append("the render plugin logged no view (it did not draw the model)")
+    else:
+        lights = [l for v in views for l in lib.read_text(v).splitlines() if l.startswith("light ")]
+        if len(lights) != 2 or lights[0] == lights[1]:
+            failures.append(f"Ctrl+Shift+drag did not move the light the plugin uses: {lights}")
+        for view, png in zip(views, ("view.png", "view_moved.png")):
+            cmd = [a.check, result, view, os.path.join(shots, png), os.path.join(shots, "diff_" + png)] + \
+                values(lines, "panel_rect")[:1]
+            proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+            print(proc.stdout.decode("utf-8", "replace").strip())
+            if proc.returncode != 0:
+                failures.append(f"{png} does not match the relight renderer (exit status {proc.returncode})")
+    if failures:
+        print("FAILED:\n  " + "\n  ".join(failures))
+        print(lib.read_text(os.path.join(shots, "meshlab_output.txt"))[-4000:])
+        return 1
+    print("ok: the live view matches the relight renderer before and after the light was moved")
+    return 0
+
+
+def cmd_live_relight_no_model(a):
+    shutil.rmtree(a.workdir, ignore_errors=True)
+    os.makedirs(a.workdir)
+    shots = os.path.join(a.workdir, "shots")
+    view_log = os.path.join(a.workdir, "view_log.txt")
+    rc, lines = run_gui(a, a.project, "", {}, shots, extra_env={"VBRDF_GUI_RENDER": RELIGHT,
+                                                                 "VBRDF_RELIGHT_VIEW_LOG": view_log})
+    failures = []
+    if rc != 0:
+        failures.append(f"meshlab/driver exit status {rc}")
+    log = " ".join(values(lines, "log"))
+    for needed in ("has no per-vertex attribute 'kd'", "MeshLab's normal rendering", "Vertex BRDF: load result attributes"):
+        if needed not in log:
+            failures.append(f"the log lacks '{needed}'")
+    if os.path.exists(view_log):
+        failures.append("the plugin drew a model although the mesh has none")
+    panel = values(lines, "panel_rect")
+    if not panel:
+        failures.append("the panel with the message is not shown")
+    proc = subprocess.run([a.check, "--fallback", os.path.join(shots, "view_before.png"), os.path.join(shots, "view.png"),
+                           panel[0] if panel else "0,0,0,0", os.path.join(shots, "diff_fallback.png")],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    print(proc.stdout.decode("utf-8", "replace").strip())
+    if proc.returncode != 0:
+        failures.append("the view is not MeshLab's own rendering")
+    if failures:
+        print("FAILED:\n  " + "\n  ".join(failures))
+        return 1
+    print("ok: without a model the message is logged and MeshLab's rendering is shown")
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("command", choices=["typed-paths", "dialogs"])
+    ap.add_argument("command", choices=["typed-paths", "dialogs", "live-relight", "live-relight-no-model"])
     ap.add_argument("--project", required=True)
     ap.add_argument("--meshlab", required=True)
     ap.add_argument("--lib-dir", required=True)
     ap.add_argument("--driver", required=True)
     ap.add_argument("--workdir", required=True)
+    ap.add_argument("--check", help="vbrdf_live_view_check (live-relight commands)")
     a = ap.parse_args()
     a.workdir = os.path.abspath(a.workdir)
-    return {"typed-paths": cmd_typed_paths, "dialogs": cmd_dialogs}[a.command](a)
+    return {"typed-paths": cmd_typed_paths, "dialogs": cmd_dialogs, "live-relight": cmd_live_relight,
+            "live-relight-no-model": cmd_live_relight_no_model}[a.command](a)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@
 #include "gl/gl_depth.h"
 #include "gl/light_view.h"
 #include "io/output_ply.h"  // write_text_file_atomically
+#include "relight/phong_model_source.h"
 #include "inputs/viewpoints.h"
 #include "base/vec3.h"
 #include "visibility/visibility.h"  // resolved_shadow_map_size
@@ -37,12 +38,14 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
 layout(location = 3) in vec2 a_ks_alpha;
+layout(location = 4) in float a_coated;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_rho_fitted;
 out vec2 v_ks_alpha;
+out float v_coated;
 out float v_depth;
 void main() {
   vec4 view_pos = u_view * vec4(a_position, 1.0);
@@ -50,6 +53,7 @@ void main() {
   v_normal = a_normal;
   v_rho_fitted = a_rho_fitted;
   v_ks_alpha = a_ks_alpha;
+  v_coated = a_coated;
   v_depth = -view_pos.z;
   gl_Position = u_projection * view_pos;
 }
@@ -58,18 +62,17 @@ void main() {
 // Output 0: linear RGB and the RelitPixel class in alpha; output 1: view depth.
 // Shadow test as in the visibility pass: lit when the fragment is at most u_tolerance behind the
 // farthest of the 2x2 shadow-map texels around it (forgives the map's quantisation).
-const char *const kShadeFragmentShader = R"(#version 330 core
+// main() of the shading pass; the model (phong_terms) is shaders/phong_model.glsl, shared with the
+// live view (phong_model_source.h).
+const char *const kShadeFragmentMain = R"(
 in vec3 v_position;
 in vec3 v_normal;
 in vec4 v_rho_fitted;
 in vec2 v_ks_alpha;
+in float v_coated;
 in float v_depth;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
-uniform int u_half_angle_lobe;
-uniform int u_coated_diffuse;
-uniform float u_coat_index;
-uniform float u_coat_min_n_dot_e;
 uniform mat4 u_light_view;
 uniform float u_light_scale;
 uniform int u_light_perspective;
@@ -85,21 +88,6 @@ layout(location = 1) out float o_depth;
 float shadow_texel(int i, int j) {
   ivec2 p = clamp(ivec2(i, j), ivec2(0), ivec2(u_shadow_size - 1));
   return texelFetch(u_shadow_map, p, 0).r;
-}
-
-// samples/diffuse_form.h coat_transmission / diffuse_factor, term for term.
-float coat_transmission(float c) {
-  c = clamp(c, 0.0, 1.0);
-  float sin_t = sqrt(max(0.0, 1.0 - c * c)) / u_coat_index;
-  float cos_t = sqrt(max(0.0, 1.0 - sin_t * sin_t));
-  float rs = (c - u_coat_index * cos_t) / (c + u_coat_index * cos_t);
-  float rp = (u_coat_index * c - cos_t) / (u_coat_index * c + cos_t);
-  return 1.0 - 0.5 * (rs * rs + rp * rp);
-}
-float diffuse_factor(float n_dot_l, float n_dot_e) {
-  if (u_coated_diffuse == 0 || !(n_dot_l > 0.0)) return n_dot_l;
-  float t1 = coat_transmission(1.0);
-  return n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
 }
 
 void main() {
@@ -129,27 +117,14 @@ void main() {
                         max(shadow_texel(i0, j0 + 1), shadow_texel(i0 + 1, j0 + 1)));
   if (light_depth > far_depth + u_tolerance) { o_color = vec4(0.0, 0.0, 0.0, 2.0); return; }
   vec3 e = normalize(u_eye - v_position);
-  // The lobe's cosine (samples/lobe.h lobe_cosine): R.E, or N.H when u_half_angle_lobe.
-  vec3 h = l + e;
-  float s = u_half_angle_lobe != 0 ? (dot(h, h) > 1e-12 ? dot(n, h) / length(h) : 0.0) : dot(2.0 * d * n - l, e);
-  float spec = 0.0;
-  if (v_ks_alpha.x > 0.0 && s > 0.0)
-    spec = v_ks_alpha.x * exp(max(v_ks_alpha.y * log(min(s, 1.0)), -80.0));
-  o_color = vec4((v_rho_fitted.rgb * diffuse_factor(d, dot(n, e)) + vec3(spec)) * irradiance, 1.0);
+  vec3 diffuse;
+  float spec;
+  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, diffuse, spec);
+  o_color = vec4((diffuse + vec3(spec)) * irradiance, 1.0);
 }
 )";
 
-constexpr int kFloatsPerVertex = 12;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1
-
-// The shininess given to k_s = 0 vertices (see the header): median of the fitted lobes.
-float typical_shininess(const std::vector<VertexFit> &fits) {
-  std::vector<float> a;
-  for (const VertexFit &f : fits)
-    if (f.ks > 0 && f.shininess > 0 && std::isfinite(f.shininess)) a.push_back(f.shininess);
-  if (a.empty()) return 1.0f;
-  std::nth_element(a.begin(), a.begin() + long(a.size() / 2), a.end());
-  return a[a.size() / 2];
-}
+constexpr int kFloatsPerVertex = 13;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, coated 1
 
 void normalise(const float in[3], float out[3], const char *what) {
   const double len = std::sqrt(double(in[0]) * in[0] + double(in[1]) * in[1] + double(in[2]) * in[2]);
@@ -205,7 +180,7 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   clear_gl_errors(gl_);
   try {
     check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the shadow map");
-    shade_program_ = build_program(gl_, kShadeVertexShader, kShadeFragmentShader, "the relighting pass");
+    shade_program_ = build_program(gl_, kShadeVertexShader, phong_program_source(kShadeFragmentMain).c_str(), "the relighting pass");
     shadow_program_ = build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map");
     upload(mesh, fits);
     check_gl_error(gl_, "the upload of the mesh for relighting");
@@ -229,6 +204,7 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
     o[9] = f.status == kFitNone ? 0.0f : 1.0f;
     o[10] = f.ks;
     o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
+    o[12] = settings_.diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
   }
   index_count_ = mesh.index_count;
 
@@ -238,8 +214,8 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[4] = {3, 3, 4, 2}, offsets[4] = {0, 3, 6, 10};
-  for (GLuint a = 0; a < 4; ++a) {
+  const int sizes[5] = {3, 3, 4, 2, 1}, offsets[5] = {0, 3, 6, 10, 12};
+  for (GLuint a = 0; a < 5; ++a) {
     gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
                             reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
     gl_.EnableVertexAttribArray(a);
@@ -329,10 +305,7 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, projection.m);
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
-  gl_.Uniform1i(gl_.GetUniformLocation(p, "u_half_angle_lobe"), settings_.lobe == LobeForm::BlinnNH ? 1 : 0);
-  gl_.Uniform1i(gl_.GetUniformLocation(p, "u_coated_diffuse"), settings_.diffuse == DiffuseForm::Coated ? 1 : 0);
-  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_coat_index"), kCoatIndex);
-  gl_.Uniform1f(gl_.GetUniformLocation(p, "u_coat_min_n_dot_e"), kCoatMinNdotE);
+  set_phong_model_uniforms(gl_, p, settings_.lobe);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), lv.scale);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_light_perspective"), lv.perspective ? 1 : 0);

@@ -7,7 +7,8 @@
 // relight_report.h (the relight filter's table and files).
 //
 // Shading is per pixel: the vertex normal and the model parameters (rho = k_d C, k_s, alpha) are
-// interpolated over each triangle and the model is evaluated per fragment as evaluate_phong does
+// interpolated over each triangle and the model is evaluated per fragment as evaluate_phong does,
+// by shaders/phong_model.glsl (shared with the live view, live_relight.h; differences stated there)
 // (E from the fragment to the camera centre; the lobe's cosine R.E, R = 2(N.L)N - L, or N.H as
 // settings.lobe says; the diffuse factor N.L or coated as settings.diffuse says, diffuse_form.h). Where k_s = 0 the shininess is
 // undefined (0); such vertices take the median shininess of the fitted lobes, so that a lobe fades
@@ -56,7 +57,7 @@ struct RelightRenderSettings {
                                   // fit's visibility pass (resolved_shadow_map_size)
   float depth_tolerance = 0.002f; // shadow test slack, fraction of the bounding-box diagonal
   LobeForm lobe = LobeForm::PhongRE;  // the fit's lobe form (its result's lobe_form; lobe.h)
-  DiffuseForm diffuse = DiffuseForm::Lambert;  // the fit's diffuse form (its result's diffuse_form; diffuse_form.h)
+  DiffuseForms diffuse;  // the fit's diffuse forms, per vertex where they vary (its result's diffuse_form; diffuse_form.h)
 };
 
 // Renders one mesh with its per-vertex fits (one VertexFit per vertex). The mesh and the fits are

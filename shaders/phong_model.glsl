@@ -1,0 +1,64 @@
+// The per-vertex Phong model, evaluated per fragment: the one GLSL copy shared by the relight
+// renderer (core/relight/relight_render.cpp, the relight filter's images) and the live view
+// (core/relight/live_relight.cpp, MeshLab's "Vertex BRDF: relight" render plugin). Both programs
+// are "#version 330 core" + this file + their own main() (relight/phong_model_source.h); there is
+// no #version here.
+//
+// Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
+//   f = rho d + k_s max(s, 0)^alpha,  rho = k_d C,  unit irradiance
+//   d: the diffuse factor, N.L (Lambert) or N.L T(N.L) T(max(N.E, 0.2)) / T(1)^2 (coated), per
+//      vertex (`coated` 1 or 0, DiffuseForms; blended linearly across a triangle that has both);
+//   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
+//   N.L <= 0: attached shadow, black (the callers test it before calling phong_terms).
+// Vertices with k_s = 0 carry the median shininess of the fitted lobes (chosen on the CPU), so
+// that a lobe fades with k_s across a triangle instead of widening.
+//
+// Differences between the two users (stated here and in the README, "Live relighting"):
+//   - cast shadows: the relight renderer tests a shadow map; the live view has none (attached
+//     shadows only), so where the object shadows itself the live view is lit;
+//   - E: the relight renderer's camera is always perspective; the live view takes MeshLab's,
+//     which is orthographic at its smallest field of view: then E is the view axis everywhere;
+//   - output: the relight renderer writes linear values (clipped later, for comparisons); the
+//     live view multiplies by the exposure, clips at 1 and encodes sRGB for the screen.
+
+uniform int u_half_angle_lobe;        // 0: R.E, 1: N.H
+uniform float u_coat_index;           // kCoatIndex
+uniform float u_coat_min_n_dot_e;     // kCoatMinNdotE
+
+// samples/diffuse_form.h coat_transmission.
+float coat_transmission(float c) {
+  c = clamp(c, 0.0, 1.0);
+  float sin_t = sqrt(max(0.0, 1.0 - c * c)) / u_coat_index;
+  float cos_t = sqrt(max(0.0, 1.0 - sin_t * sin_t));
+  float rs = (c - u_coat_index * cos_t) / (c + u_coat_index * cos_t);
+  float rp = (u_coat_index * c - cos_t) / (u_coat_index * c + cos_t);
+  return 1.0 - 0.5 * (rs * rs + rp * rp);
+}
+
+// samples/diffuse_form.h diffuse_factor; `coated` in [0, 1] (interpolated vertex flag).
+float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
+  if (!(coated > 0.0) || !(n_dot_l > 0.0)) return n_dot_l;
+  float t1 = coat_transmission(1.0);
+  float coat = n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
+  return mix(n_dot_l, coat, min(coated, 1.0));
+}
+
+// samples/lobe.h lobe_cosine: R.E, or N.H (0 when L = -E).
+float lobe_cosine(vec3 n, vec3 l, vec3 e) {
+  vec3 h = l + e;
+  if (u_half_angle_lobe != 0) return dot(h, h) > 1e-12 ? dot(n, h) / length(h) : 0.0;
+  return dot(2.0 * dot(n, l) * n - l, e);
+}
+
+// k_s s^alpha for s > 0 (the exponent's logarithm floored at -80: no denormals, no NaN).
+float phong_specular(float ks, float alpha, float s) {
+  if (!(ks > 0.0) || !(s > 0.0)) return 0.0;
+  return ks * exp(max(alpha * log(min(s, 1.0)), -80.0));
+}
+
+// The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value.
+void phong_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, vec3 l, vec3 e, out vec3 diffuse,
+                 out float specular) {
+  diffuse = rho * diffuse_factor(dot(n, l), dot(n, e), coated);
+  specular = phong_specular(ks, alpha, lobe_cosine(n, l, e));
+}
