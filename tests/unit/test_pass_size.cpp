@@ -90,13 +90,14 @@ TEST(PassSize, CameraDivisorFollowsTheProjectedEdges) {
   };
   // The plane at distance ~3 with focal 0.9 W: an edge spans ~0.003 W pixels.
   EXPECT_EQ(divisor_at(640), 1);    // ~1.9 px: photo resolution
-  EXPECT_EQ(divisor_at(1200), 2);   // ~3.6 px
-  EXPECT_EQ(divisor_at(2000), 3);   // ~6 px: 4 would leave 500 < kMinCameraPassSide texels
-  EXPECT_EQ(divisor_at(4000), kMaxCameraDivisor);  // ~12 px: capped
-  for (int w : {640, 1200, 2000, 2600, 4000}) {
+  EXPECT_EQ(divisor_at(1200), 1);   // ~3.6 px
+  EXPECT_EQ(divisor_at(2200), 2);   // ~6.6 px
+  EXPECT_EQ(divisor_at(4400), kMaxCameraDivisor);  // ~13 px
+  EXPECT_EQ(divisor_at(6000), kMaxCameraDivisor);  // ~18 px: capped
+  for (int w : {640, 1200, 2200, 2600, 4400}) {
     const int d = divisor_at(w);
     const double edge_px = 0.01 * 0.9 * w / 3.0;
-    EXPECT_LE(d * kCameraPixelsPerEdge, edge_px * 1.2) << w;  // a map texel <= median edge / k
+    if (d > 1) EXPECT_LE(d * kCameraPixelsPerEdge, edge_px * 1.2) << w;  // a map texel <= median edge / k
     EXPECT_GE((w + d - 1) / d, kMinCameraPassSide) << w;
   }
   s.camera_pass_divisor = 3;

@@ -1136,7 +1136,7 @@ TEST_F(GlVisibilityTest, ComputeShaderTestsGiveTheReadBackCodes) {
   };
   const size_t limit = vertex_count(m) / 1000;
   // The last shot's pass is divided (a map texel of 2 x 2 photo pixels, pass_size.h).
-  for (const Shot &shot : {dense_scene_camera(), dense_scene_camera(321, 237), dense_scene_camera(1200, 900)}) {
+  for (const Shot &shot : {dense_scene_camera(), dense_scene_camera(321, 237), dense_scene_camera(1800, 1350)}) {
     const auto a = run_camera(*gpu, m, shot), b = run_camera(*readback, m, shot);
     EXPECT_EQ(gpu->last_pass_sizes().camera_divisor, readback->last_pass_sizes().camera_divisor);
     std::printf("  camera %dx%d: %zu of %u vertices differ; %ld hidden, %ld partial footprints\n",
@@ -1192,9 +1192,9 @@ TEST_F(GlVisibilityTest, ComputeShaderTestsRestoreTheHostsBindings) {
   api.DeleteBuffers(2, host_buffers);
 }
 
-// Camera passes smaller than the photo (pass_size.h): a 26 800-vertex scene photographed at 1200
-// and 3200 pixels wide, where the mesh's edges span ~4.5 and ~12 pixels, so the automatic pass is
-// rendered at 1/2 and 1/4 of the photo's resolution. Against the CPU ray caster (exact rays, the
+// Camera passes smaller than the photo (pass_size.h): a 26 800-vertex scene photographed at 1800
+// and 3600 pixels wide, where the mesh's edges span ~6.8 and ~13.6 pixels, so the automatic pass
+// is rendered at 1/2 and 1/4 of the photo's resolution. Against the CPU ray caster (exact rays, the
 // footprint texels cast at photo resolution):
 //  - occlusion: the bound of photo-resolution passes (<= 2 % of the front-facing vertices
 //    disagree, nearly all within a map texel of an occluder's silhouette);
@@ -1213,12 +1213,12 @@ TEST_F(GlVisibilityTest, DividedCameraPassesAgreeWithTheCpu) {
   const auto partial = [](const std::vector<uint8_t> &codes) {
     return size_t(std::count_if(codes.begin(), codes.end(), [](uint8_t c) { return (c & kFootprintPartial) != 0; }));
   };
-  for (int width : {1200, 3200}) {
+  for (int width : {1800, 3600}) {
     const Shot shot = dense_scene_camera(width, width * 3 / 4);
     std::vector<uint8_t> a;
     char label[64];
     std::snprintf(label, sizeof label, "dense camera %dx%d, sized", width, width * 3 / 4);
-    const int d_expected = width == 1200 ? 2 : 4;
+    const int d_expected = width == 1800 ? 2 : 4;
     const Comparison cmp = compare_camera(*sized, *cpu, m, shot, &a, 2.0 * d_expected);
     const int d = sized->last_pass_sizes().camera_divisor;
     EXPECT_EQ(d, d_expected) << "the scene must exercise a divided pass";

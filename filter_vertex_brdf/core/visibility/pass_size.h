@@ -22,6 +22,8 @@
 //    a depth jump wider than a map texel is never reported clean; some texels next to a silhouette
 //    (a band <= d pixels wide) or on steep faces are reported as not own that a photo-resolution
 //    pass would call own: their samples become rim samples (used where a vertex has < 2 clean).
+//    kCameraPixelsPerEdge is 3 (d = 2 from 6-pixel edges): at 1.5 the 1 M-vertex benchmark at
+//    4000x3000 (3.2-pixel edges, d = 2) raised the albedo error from 0.46 to 0.59 (README).
 #include <string>
 #include <vector>
 
@@ -35,7 +37,7 @@ namespace vbrdf {
 constexpr float kShadowTexelsPerEdge = 4.0f;
 constexpr int kMinShadowMapSize = 1024;
 constexpr int kMaxShadowMapSize = 4096;
-constexpr float kCameraPixelsPerEdge = 1.5f;
+constexpr float kCameraPixelsPerEdge = 3.0f;
 constexpr int kMaxCameraDivisor = 4;
 constexpr int kMinCameraPassSide = 512;
 
