@@ -6,7 +6,8 @@
 //
 // Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
 //   f = rho d + k_s max(s, 0)^alpha,  rho = k_d C,  unit irradiance
-//   d: the diffuse factor, N.L (Lambert) or N.L T(N.L) T(max(N.E, 0.2)) / T(1)^2 (coated);
+//   d: the diffuse factor, N.L (Lambert) or N.L T(N.L) T(max(N.E, 0.2)) / T(1)^2 (coated), chosen
+//      per vertex (DiffuseForms: 1 coated, 0 Lambert) and mixed linearly where a triangle has both;
 //   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
 //   N.L <= 0: attached shadow, black (the callers test it before calling phong_terms).
 // Vertices with k_s = 0 carry the median shininess of the fitted lobes (chosen on the CPU), so
@@ -21,7 +22,6 @@
 //     live view multiplies by the exposure, clips at 1 and encodes sRGB for the screen.
 
 uniform int u_half_angle_lobe;        // 0: R.E, 1: N.H
-uniform int u_coated_diffuse;         // 0: Lambert, 1: coated
 uniform float u_coat_index;           // kCoatIndex
 uniform float u_coat_min_n_dot_e;     // kCoatMinNdotE
 
@@ -35,11 +35,13 @@ float coat_transmission(float c) {
   return 1.0 - 0.5 * (rs * rs + rp * rp);
 }
 
-// samples/diffuse_form.h diffuse_factor.
-float diffuse_factor(float n_dot_l, float n_dot_e) {
-  if (u_coated_diffuse == 0 || !(n_dot_l > 0.0)) return n_dot_l;
+// samples/diffuse_form.h diffuse_factor; `coated` is the vertices' form interpolated over the
+// triangle (1 coated, 0 Lambert).
+float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
+  if (coated <= 0.0 || !(n_dot_l > 0.0)) return n_dot_l;
   float t1 = coat_transmission(1.0);
-  return n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
+  float coat = n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
+  return mix(n_dot_l, coat, min(coated, 1.0));
 }
 
 // samples/lobe.h lobe_cosine: R.E, or N.H (0 when L = -E).
@@ -56,7 +58,8 @@ float phong_specular(float ks, float alpha, float s) {
 }
 
 // The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value.
-void phong_terms(vec3 rho, float ks, float alpha, vec3 n, vec3 l, vec3 e, out vec3 diffuse, out float specular) {
-  diffuse = rho * diffuse_factor(dot(n, l), dot(n, e));
+void phong_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, vec3 l, vec3 e, out vec3 diffuse,
+                 out float specular) {
+  diffuse = rho * diffuse_factor(dot(n, l), dot(n, e), coated);
   specular = phong_specular(ks, alpha, lobe_cosine(n, l, e));
 }

@@ -34,7 +34,7 @@ RelightModel relight_model(MeshModel &mesh) {
                             "' has a fitted model (fit_status 0 everywhere); MeshLab's normal rendering is shown. "
                             "Check the fit's log for why no vertex was fitted.");
   model.lobe = vbrdf::lobe_form_of(records, "mesh '" + name + "'");
-  model.diffuse = vbrdf::diffuse_form_of(records, "mesh '" + name + "'");
+  model.diffuse = vbrdf::diffuse_forms_of(records);
   return model;
 }
 

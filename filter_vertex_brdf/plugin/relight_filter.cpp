@@ -98,7 +98,7 @@ std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &
   const std::vector<vbrdf::VertexRecord> records = vbrdf::records_from_columns(columns, utf8(mesh.label()));
   for (const vbrdf::VertexRecord &record : records) fits.push_back(record.fit);
   render.lobe = vbrdf::lobe_form_of(records, utf8(mesh.label()));
-  render.diffuse = vbrdf::diffuse_form_of(records, utf8(mesh.label()));
+  render.diffuse = vbrdf::diffuse_forms_of(records);
   return fits;
 }
 

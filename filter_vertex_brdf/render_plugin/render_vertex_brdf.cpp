@@ -87,7 +87,7 @@ bool RenderVertexBrdfPlugin::ensure_model(MeshModel &mesh, MeshDocument &md, GLA
                              .arg(mesh.label())
                              .arg(model.modelled)
                              .arg(vbrdf::lobe_form_label(model.lobe))
-                             .arg(vbrdf::diffuse_form_name(model.diffuse));
+                             .arg(QString::fromStdString(vbrdf::describe_diffuse_forms(model.diffuse)));
     md.Log.Log(GLLogStream::FILTER, qUtf8Printable(what));
     if (panel_) panel_->set_message(what.mid(QString("Vertex BRDF relight: ").size()), false);
   } catch (const std::exception &e) {  // InputError: no model; ProcessingError: GL

@@ -55,7 +55,7 @@ int run(int argc, char **argv) {
   vbrdf::test::OsMesaContext context;
   const auto t_upload = std::chrono::steady_clock::now();
   vbrdf::LiveRelight live(mesh.view(), fits, context.get_proc_address(), vbrdf::LobeForm::PhongRE,
-                          vbrdf::DiffuseForm::Lambert);
+                          vbrdf::DiffuseForms::everywhere(vbrdf::DiffuseForm::Lambert));
   const double upload = seconds_since(t_upload);
   // Camera 3 units away on +z, 40 degree vertical field of view.
   vbrdf::LiveView view;

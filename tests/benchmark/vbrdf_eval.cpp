@@ -167,7 +167,7 @@ int main(int argc, char **argv) {
   return test::run_tool([&]() -> int {
     const ResultPly result = read_result_ply(result_path);
     LobeForm lobe = LobeForm::PhongRE;
-    DiffuseForm diffuse = DiffuseForm::Lambert;
+    DiffuseForms diffuse;
     const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe, &diffuse);
     const MeshView mesh_view = result.mesh.view();
     const LightPlacement placement =

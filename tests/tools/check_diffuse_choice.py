@@ -4,13 +4,16 @@ picks the form the photos were made with, and the pick pays off at held-out ligh
 
     check_diffuse_choice.py --synth synthesize_scene --fit-tool vbrdf_fit --eval-tool vbrdf_eval --workdir DIR
 
-Two synthetic captures of one scene (synthesize_scene, 16-bit linear photos): one Lambertian, one
-with --coated-diffuse (the diffuse term under a clear coat: Fresnel transmission in and out, the
-synthesizer's own exact formula). Checks (each can fail):
-  * Auto writes diffuse_form 0 on the Lambertian capture and 1 on the coated one, and the report
-    says it was Auto's pilot that chose;
+Three synthetic captures of one scene (synthesize_scene, 16-bit linear photos): Lambertian, with
+--coated-diffuse (the diffuse term under a clear coat: Fresnel transmission in and out, the
+synthesizer's own exact formula), and with --coated-glossy (the coat only on the glossy regions:
+two materials). Checks (each can fail):
+  * Auto writes diffuse_form 0 everywhere on the Lambertian capture and 1 everywhere on the coated
+    one, and the report says it was Auto's pilot that chose;
   * on the coated capture, the Auto fit relights the held-out photos better (vbrdf_eval mean
-    CIEDE2000) than a fit forced to Lambert, and its albedo (k_d C) is nearer the truth.
+    CIEDE2000) than a fit forced to Lambert, and its albedo (k_d C) is nearer the truth;
+  * on the two-material capture, Auto writes a coat map that agrees with the truth's glossy regions
+    on >= 85 % of the modelled vertices, and relights better than both forms used everywhere.
 """
 import argparse
 import os
@@ -27,9 +30,9 @@ def run(cmd):
     return p.returncode, p.stdout
 
 
-def synthesize(args, out, coated):
+def synthesize(args, out, coat_option):
     cmd = [args.synth, "--out", out, "--vertices", "4000", "--width", "320", "--height", "240", "--lights", "24",
-           "--heldout", "4", "--linear16", "--quiet", "--seed", "7"] + (["--coated-diffuse"] if coated else [])
+           "--heldout", "4", "--linear16", "--quiet", "--seed", "7"] + ([coat_option] if coat_option else [])
     rc, text = run(cmd)
     if rc != 0:
         raise SystemExit(f"FAIL: synthesize_scene exited {rc}:\n{text}")
@@ -42,11 +45,10 @@ def fit(args, scene, out, form):
     return text
 
 
-def diffuse_form(ply_path):
-    values = set(lib.read_ply(ply_path).vertex["diffuse_form"])
-    if len(values) != 1:
-        raise SystemExit(f"FAIL: {ply_path}: diffuse_form is not one value per result: {sorted(values)}")
-    return int(values.pop())
+def diffuse_forms(ply_path):
+    """The per-vertex diffuse_form of the modelled vertices."""
+    v = lib.read_ply(ply_path).vertex
+    return [int(f) for f, status in zip(v["diffuse_form"], v["fit_status"]) if status != 0]
 
 
 def relit_mean(args, scene, fit_ply):
@@ -71,6 +73,28 @@ def albedo_error(fit_ply, gt_ply):
     return total / n
 
 
+def check_two_materials(args):
+    scene = os.path.join(args.workdir, "two_materials")
+    synthesize(args, scene, "--coated-glossy")
+    failures, relit = [], {}
+    for form in ("auto", "lambert", "coated"):
+        out = os.path.join(args.workdir, f"two_materials_{form}.ply")
+        log = fit(args, scene, out, form)
+        relit[form] = relit_mean(args, scene, out)
+    fit_v = lib.read_ply(os.path.join(args.workdir, "two_materials_auto.ply")).vertex
+    gt = lib.read_ply(os.path.join(scene, "ground_truth", "gt_vertex.ply")).vertex
+    pairs = [(int(f), ks > 0) for f, status, ks in zip(fit_v["diffuse_form"], fit_v["fit_status"], gt["ks"]) if status != 0]
+    agree = sum(1 for f, glossy in pairs if f == int(glossy)) / max(len(pairs), 1)
+    print(f"two-material capture: coat map agrees with the glossy regions on {100 * agree:.1f} % of "
+          f"{len(pairs)} modelled vertices; relit mean CIEDE2000 Auto {relit['auto']:.3f}, "
+          f"Lambert everywhere {relit['lambert']:.3f}, coated everywhere {relit['coated']:.3f}")
+    if agree < 0.85:
+        failures.append(f"two-material capture: the coat map agrees with the truth on {100 * agree:.1f} % (< 85 %)")
+    if not relit["auto"] < min(relit["lambert"], relit["coated"]):
+        failures.append("two-material capture: Auto's coat map does not relight better than both uniform forms")
+    return failures
+
+
 def main():
     ap = argparse.ArgumentParser()
     for a in ("--synth", "--fit-tool", "--eval-tool", "--workdir"):
@@ -78,17 +102,18 @@ def main():
     args = ap.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
     failures = []
-    for name, coated in (("lambert", False), ("coated", True)):
+    for name, option, expected in (("lambert", None, 0), ("coated", "--coated-diffuse", 1)):
         scene = os.path.join(args.workdir, name)
-        synthesize(args, scene, coated)
+        synthesize(args, scene, option)
         out = os.path.join(args.workdir, name + "_auto.ply")
         log = fit(args, scene, out, "auto")
-        form = diffuse_form(out)
-        print(f"{name} capture: Auto chose diffuse_form {form}")
-        if form != int(coated):
-            failures.append(f"{name} capture: Auto chose diffuse_form {form}, expected {int(coated)}")
+        forms = set(diffuse_forms(out))
+        print(f"{name} capture: Auto wrote diffuse_form {sorted(forms)}")
+        if forms != {expected}:
+            failures.append(f"{name} capture: Auto wrote diffuse_form {sorted(forms)}, expected {expected} everywhere")
         if not re.search(r"diffuse term: (lambert|coated) \(Auto: pilot fit of \d+ vertices", log):
             failures.append(f"{name} capture: the report does not say how Auto chose:\n{log}")
+    failures += check_two_materials(args)
     scene = os.path.join(args.workdir, "coated")
     forced = os.path.join(args.workdir, "coated_lambert.ply")
     fit(args, scene, forced, "lambert")

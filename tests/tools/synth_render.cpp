@@ -186,7 +186,8 @@ cv::Mat render_photo(const RenderContext &ctx, const ViewRaster &r, const Shot &
           const float al = s.shininess[a] * w0 + s.shininess[b] * w1 + s.shininess[c] * w2;
           const V3 C = s.color[a] * w0 + s.color[b] * w1 + s.color[c] * w2;
           // Directional: falloff is exactly 1, so E * 1 keeps the bytes of the directional renders.
-          sum = sum + phong(kd, ks, al, C, N, in.L, normalize(eye - P), set.irradiance * in.falloff, set.coated_diffuse);
+          const bool coated = set.coated_diffuse && (!set.coat_glossy_only || ks > 0);
+          sum = sum + phong(kd, ks, al, C, N, in.L, normalize(eye - P), set.irradiance * in.falloff, coated);
         }
       sum = sum * (1.0f / float(ss * ss));  // box filter in linear radiance, before clipping
       const float rgb[3] = {sum.x, sum.y, sum.z};

@@ -21,6 +21,7 @@ struct ShadeSettings {
   uint64_t seed = 1;        // noise seed
   bool coated_diffuse = false;  // diffuse body under a clear coat of index 1.5 (--coated-diffuse):
                                 //   k_d N.L C scaled by the Fresnel transmission in and out, t(N.L) t(N.V) / t(1)^2
+  bool coat_glossy_only = false;  // ... only where k_s > 0 (--coated-glossy: a coated and a bare material)
 };
 
 // The model, per colour channel, without the visibility factor:

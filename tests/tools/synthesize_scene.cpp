@@ -12,7 +12,7 @@
 //
 //   P_c = E * ( k_d * max(N.L, 0) * C_c + k_s * max(R.V, 0)^alpha ) * visible_from_light
 //   (--coated-diffuse: the k_d term times t(N.L) t(N.V) / t(1)^2, t the Fresnel transmission into
-//   index 1.5)
+//   index 1.5; --coated-glossy: the same only where k_s > 0)
 //   R   = 2 (N.L) N - L
 //
 //   L  unit direction from the surface towards the light (directional light, world frame)
@@ -62,7 +62,7 @@ struct Options {
   float noise = 0;
   uint64_t seed = 1;
   float irradiance = 1;
-  bool coated_diffuse = false;
+  bool coated_diffuse = false, coat_glossy_only = false;
   int ss = 2;
   float azimuth = 30, elevation = 35, fov = 40;
   float offset_x = 0, offset_y = 0;
@@ -86,6 +86,7 @@ const char *kUsage =
     "  --irradiance E         light irradiance (default 1)\n"
     "  --coated-diffuse       diffuse term under a clear coat (index 1.5): times the Fresnel\n"
     "                         transmission in and out, t(N.L) t(N.V) / t(1)^2 (default: Lambert)\n"
+    "  --coated-glossy        the same, only where k_s > 0 (a coated and a bare material)\n"
     "  --ss S                 supersampling per axis (default 2)\n"
     "  --azimuth DEG --elevation DEG   first camera (default 30 35); view k adds k*360/K to\n"
     "                         the azimuth and 12 degrees of elevation on odd k\n"
@@ -140,6 +141,7 @@ Options parse_options(int argc, char **argv) {
     else if (a == "--threads") o.threads = std::atoi(*need(i, 1)), i += 1;
     else if (a == "--quiet") o.quiet = true;
     else if (a == "--coated-diffuse") o.coated_diffuse = true;
+    else if (a == "--coated-glossy") o.coated_diffuse = o.coat_glossy_only = true;
     else if (a == "--help" || a == "-h") { std::cout << kUsage; std::exit(0); }
     else throw std::runtime_error("unknown option " + a);
   }
@@ -165,7 +167,7 @@ std::string canonical_options(const Options &o) {
     << " --elevation " << o.elevation << " --fov " << o.fov << " --center-offset " << o.offset_x
     << " " << o.offset_y << " --light-elevation " << o.light_elev_min << " " << o.light_elev_max;
   if (o.light_distance > 0) s << " --light-distance " << o.light_distance;  // absent: directional
-  if (o.coated_diffuse) s << " --coated-diffuse";  // absent: Lambert
+  if (o.coated_diffuse) s << (o.coat_glossy_only ? " --coated-glossy" : " --coated-diffuse");  // absent: Lambert
   return s.str();
 }
 
@@ -553,6 +555,7 @@ int main(int argc, char **argv) {
     set.noise_sigma = o.noise;
     set.seed = o.seed;
     set.coated_diffuse = o.coated_diffuse;
+    set.coat_glossy_only = o.coat_glossy_only;
     // Photos of one view share its raster; each photo is shaded, checked and written by one
     // thread (PNG compression is the slow serial part otherwise).
     std::vector<Stats> photo_stats(train.size());

@@ -47,6 +47,19 @@ TEST(DiffuseForm, ViewSideIsClampedAndSignAndFinitenessKept) {
   EXPECT_TRUE(std::isfinite(diffuse_factor(DiffuseForm::Coated, 1.0f, std::numeric_limits<float>::max())));
 }
 
+TEST(DiffuseForm, FormsPerVertexFallBackToTheUniformOne) {
+  const DiffuseForms uniform = DiffuseForms::everywhere(DiffuseForm::Coated);
+  EXPECT_FALSE(uniform.varies());
+  EXPECT_EQ(uniform.at(12345), DiffuseForm::Coated);
+  EXPECT_EQ(describe_diffuse_forms(uniform), "coated");
+  const DiffuseForms map{DiffuseForm::Lambert, std::make_shared<std::vector<uint8_t>>(std::vector<uint8_t>{1, 0, 1})};
+  EXPECT_TRUE(map.varies());
+  EXPECT_EQ(map.at(0), DiffuseForm::Coated);
+  EXPECT_EQ(map.at(1), DiffuseForm::Lambert);
+  EXPECT_EQ(map.at(3), DiffuseForm::Lambert);  // beyond the map: the uniform form
+  EXPECT_EQ(describe_diffuse_forms(map), "coated on 2 of 3 vertices, lambert elsewhere");
+}
+
 TEST(DiffuseForm, NamesRoundTrip) {
   DiffuseForm f = DiffuseForm::Lambert;
   EXPECT_TRUE(parse_diffuse_form(diffuse_form_name(DiffuseForm::Coated), f));

@@ -75,9 +75,17 @@ struct PlaneCheck {
   size_t checked = 0, shadowed = 0, unfitted = 0;
   double worst = 0, brightest = 0, darkest = 1e9;
 };
+// A coat map (settings.diffuse varying) is given as coated on the vertices with x < 0; pixels over
+// the column of triangles between x = -0.5 and 0 (grid spacing 0.5), which blend both forms, are
+// not checked.
 PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
-                        const RelightRenderSettings &settings = RelightRenderSettings()) {
+                        RelightRenderSettings settings = RelightRenderSettings(), bool coat_map = false) {
   const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
+  if (coat_map) {
+    auto coated = std::make_shared<std::vector<uint8_t>>(mesh.positions.size() / 3, 0);
+    for (size_t v = 0; v < coated->size(); ++v) (*coated)[v] = mesh.positions[3 * v] < 0 ? 1 : 0;
+    settings.diffuse = DiffuseForms{DiffuseForm::Lambert, coated};
+  }
   const float rho[3] = {0.5f, 0.3f, 0.1f};
   const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
   RelightRenderer renderer(mesh.view(), fits, ctx.get_proc_address(), settings);
@@ -99,7 +107,9 @@ PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
       const float d = n * lv;
       const vcg::Point3f refl = n * (2 * d) - lv;
       float expected[3];
-      evaluate_phong(fits[0], diffuse_factor(settings.diffuse, d, n * e), refl * e, expected);
+      if (coat_map && p[0] > -0.55f && p[0] < 0.05f) continue;
+      const DiffuseForm form = coat_map ? (p[0] < 0 ? DiffuseForm::Coated : DiffuseForm::Lambert) : settings.diffuse.uniform;
+      evaluate_phong(fits[0], diffuse_factor(form, d, n * e), refl * e, expected);
       const float irradiance = light_irradiance_at(light, pf);
       for (int k = 0; k < 3; ++k)
         c.worst = std::max(c.worst, double(std::fabs(pixel(r, x, y)[k] - expected[k] * irradiance)));
@@ -125,13 +135,16 @@ TEST(RelightRender, CoatedDiffuseMatchesTheModelEverywhere) {
   REQUIRE_GL(ctx);
   const LightSource low = LightSource::directional({{1.0f, 0.3f, 0.2f}});  // N.L about 0.28
   RelightRenderSettings coated;
-  coated.diffuse = DiffuseForm::Coated;
+  coated.diffuse = DiffuseForms::everywhere(DiffuseForm::Coated);
   const PlaneCheck c = render_plane(*ctx, low, coated);
   EXPECT_GT(c.checked, 500u);
   EXPECT_LT(c.worst, 2e-3);
   const PlaneCheck lambert = render_plane(*ctx, low);
   EXPECT_LT(lambert.worst, 2e-3);
   EXPECT_LT(c.brightest, 0.9 * lambert.brightest);  // T(0.28)/T(1) is about 0.78
+  const PlaneCheck map = render_plane(*ctx, low, RelightRenderSettings(), true);  // per vertex
+  EXPECT_GT(map.checked, 300u);
+  EXPECT_LT(map.worst, 2e-3);
 }
 
 // A point light close over the plane: per pixel its own direction and the inverse-square fall-off.

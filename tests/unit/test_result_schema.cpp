@@ -29,6 +29,7 @@ VertexRecord distinct_record(size_t v) {
   r.fit.dq = 1.5f + o, r.fit.sq = 1.6f + o, r.fit.rmse = 1.7f + o;
   r.fit.status = uint8_t(v % 5);
   r.fit.iterations = uint16_t(31 + v);
+  r.diffuse_form = float(v % 2);
   return r;
 }
 
@@ -104,6 +105,23 @@ TEST(ResultSchema, EachPropertyHoldsItsOwnField) {
     EXPECT_FLOAT_EQ(at("fit_status"), float(r.fit.status));
     EXPECT_FLOAT_EQ(at("fit_iterations"), float(r.fit.iterations));
   }
+}
+
+// diffuse_form: one form when every modelled vertex has it (unmodelled ones do not count), else a
+// per-vertex coat map.
+TEST(ResultSchema, DiffuseFormsAreUniformOrPerVertex) {
+  std::vector<VertexRecord> records(4);
+  for (VertexRecord &r : records) r.fit.status = kFitFull, r.diffuse_form = 1;
+  records[3].fit.status = kFitNone, records[3].diffuse_form = 0;
+  const DiffuseForms uniform = diffuse_forms_of(records);
+  EXPECT_FALSE(uniform.varies());
+  EXPECT_EQ(uniform.uniform, DiffuseForm::Coated);
+  records[1].diffuse_form = 0;
+  const DiffuseForms map = diffuse_forms_of(records);
+  ASSERT_TRUE(map.varies());
+  EXPECT_EQ(map.at(0), DiffuseForm::Coated);
+  EXPECT_EQ(map.at(1), DiffuseForm::Lambert);
+  EXPECT_EQ(map.at(2), DiffuseForm::Coated);
 }
 
 TEST(ResultSchema, WriteReadRoundTripKeepsEveryAttribute) {

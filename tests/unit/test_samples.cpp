@@ -39,6 +39,29 @@ struct Fixture {
 };
 const float kOrigin[3] = {0, 0, 0};
 const float kFacing[3] = {0, 0, 1};
+
+// `count` vertices on the plane z = 0 facing +z, `per_row` to a row from (x0, y0), spacing dx, dy.
+MeshData facing_grid(int count, int per_row, float x0, float y0, float dx, float dy) {
+  MeshData mesh;
+  for (int i = 0; i < count; ++i) {
+    mesh.positions.insert(mesh.positions.end(), {x0 + float(i % per_row) * dx, y0 + float(i / per_row) * dy, 0});
+    mesh.normals.insert(mesh.normals.end(), {0, 0, 1});
+  }
+  mesh.indices = {0, 1, uint32_t(per_row)};
+  return mesh;
+}
+
+// Every vertex seen and lit by every raster, no mixed footprints.
+VisibilityMasks all_seen(size_t vertices, size_t rasters) {
+  VisibilityMasks masks;
+  masks.vertex_count = vertices;
+  masks.raster_count = rasters;
+  masks.seen.assign(masks.words() * rasters, ~uint64_t(0));
+  masks.lit.assign(masks.words() * rasters, ~uint64_t(0));
+  masks.mixed.assign(masks.words() * rasters, 0);
+  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded}) v->assign(rasters, 0);
+  return masks;
+}
 } // namespace
 
 TEST(Samples, HeadOnLightIsHighlightAndColourIsDecoded) {
@@ -74,7 +97,7 @@ TEST(Samples, DiffuseFactorFollowsTheForm) {
   const float low[3] = {-0.5f, 0, 0.8660254f};  // 60 degrees off the camera axis
   const float tilted[3] = {0.6f, 0, 0.8f};        // a normal at N.E = 0.8 (camera on +z): N.L = 0.393
   const Sample lambert = f.sample(kOrigin, tilted, low);
-  f.settings.diffuse = DiffuseForm::Coated;
+  f.settings.diffuse = DiffuseForms::everywhere(DiffuseForm::Coated);
   const Sample coated = f.sample(kOrigin, tilted, low);
   const float nl = -0.6f * 0.5f + 0.8f * 0.8660254f, ne = 0.8f;
   EXPECT_NEAR(lambert.d, nl, 1e-3);
@@ -109,21 +132,10 @@ TEST(Samples, SaturatedPixelIsFlagged) {
 TEST(Samples, GatherStreamsChunksInVertexOrder) {
   // 3000 vertices on a plane facing the camera, 2 photos, forcing ~3 chunks.
   Fixture f;
-  MeshData mesh;
-  for (int i = 0; i < 3000; ++i) {
-    mesh.positions.insert(mesh.positions.end(), {-0.5f + (i % 60) / 60.0f, -0.4f + (i / 60) / 70.0f, 0});
-    mesh.normals.insert(mesh.normals.end(), {0, 0, 1});
-  }
-  mesh.indices = {0, 1, 60};
+  const MeshData mesh = facing_grid(3000, 60, -0.5f, -0.4f, 1.0f / 60, 1.0f / 70);
   std::vector<Raster> rasters = {f.raster, f.raster};
   std::vector<std::array<float, 3>> lights = {{{0, 0, 1}}, {{0.8660254f, 0, 0.5f}}};
-  VisibilityMasks masks;
-  masks.vertex_count = 3000;
-  masks.raster_count = 2;
-  masks.seen.assign(masks.words() * 2, ~uint64_t(0));
-  masks.lit.assign(masks.words() * 2, ~uint64_t(0));
-  masks.mixed.assign(masks.words() * 2, 0);
-  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded}) v->assign(2, 0);
+  VisibilityMasks masks = all_seen(3000, 2);
   masks.lit[masks.words() + 0] = 0;  // raster 1: vertices 0..63 in cast shadow
   masks.seen[masks.words() + 1] = 0;  // raster 1 does not see vertices 64..127
   GatherSettings settings;
@@ -254,24 +266,13 @@ TEST(Samples, ResolutionWeightFollowsDistanceAndObliquity) {
 
 TEST(Samples, GatherCodesEachSamplesResolutionAgainstTheVertexsBestPhoto) {
   Fixture f;
-  MeshData mesh;
-  for (int i = 0; i < 100; ++i) {
-    mesh.positions.insert(mesh.positions.end(), {-0.2f + (i % 10) / 25.0f, -0.2f + (i / 10) / 25.0f, 0});
-    mesh.normals.insert(mesh.normals.end(), {0, 0, 1});
-  }
-  mesh.indices = {0, 1, 10};
+  const MeshData mesh = facing_grid(100, 10, -0.2f, -0.2f, 1.0f / 25, 1.0f / 25);
   Raster far = f.raster;
   const float c_far[3] = {0, 0, 20}, t[3] = {0, 0, 0}, up[3] = {0, 1, 0};
   far.shot = test::make_look_at_shot(c_far, t, up, 500, 64, 48);
   const std::vector<Raster> rasters = {f.raster, far, f.raster};
   const std::vector<std::array<float, 3>> lights = {{{0, 0, 1}}, {{0, 0, 1}}, {{0.5f, 0, 0.8660254f}}};
-  VisibilityMasks masks;
-  masks.vertex_count = 100;
-  masks.raster_count = 3;
-  masks.seen.assign(masks.words() * 3, ~uint64_t(0));
-  masks.lit.assign(masks.words() * 3, ~uint64_t(0));
-  masks.mixed.assign(masks.words() * 3, 0);
-  for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded}) v->assign(3, 0);
+  const VisibilityMasks masks = all_seen(100, 3);
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   for (bool weights : {true, false}) {
     GatherSettings settings;
@@ -286,6 +287,32 @@ TEST(Samples, GatherCodesEachSamplesResolutionAgainstTheVertexsBestPhoto) {
     });
     EXPECT_EQ(checked, 300);
   }
+}
+
+// A coat map (DiffuseForms per vertex): each vertex's samples carry its own form's diffuse factor.
+TEST(Samples, GatherTakesEachVertexsDiffuseForm) {
+  Fixture f;
+  const MeshData mesh = facing_grid(100, 10, -0.2f, -0.2f, 1.0f / 25, 1.0f / 25);
+  const std::vector<Raster> rasters = {f.raster};
+  const std::vector<std::array<float, 3>> lights = {{{0.8f, 0, 0.6f}}};  // N.L = 0.6
+  const VisibilityMasks masks = all_seen(100, 1);
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
+  auto coated = std::make_shared<std::vector<uint8_t>>(100, 0);
+  for (size_t v = 0; v < 100; v += 3) (*coated)[v] = 1;
+  GatherSettings settings;
+  settings.diffuse = DiffuseForms{DiffuseForm::Lambert, coated};
+  int checked = 0;
+  gather_samples(mesh.view(), rasters, directional_lights(lights), masks, settings, cache, [&](const SampleChunk &c) {
+    for (uint32_t i = 0; i < c.vertex_count; ++i)
+      for (uint32_t k = c.offsets[i]; k < c.offsets[i + 1]; ++k, ++checked) {
+        const size_t v = c.first_vertex + i;
+        const float *p = mesh.positions.data() + 3 * v;
+        const float e_len = std::sqrt(p[0] * p[0] + p[1] * p[1] + 100.0f), ne = 10.0f / e_len;  // camera at z = 10
+        EXPECT_NEAR(c.samples[k].d, diffuse_factor((*coated)[v] ? DiffuseForm::Coated : DiffuseForm::Lambert, 0.6f, ne),
+                    1e-5) << "vertex " << v;
+      }
+  });
+  EXPECT_EQ(checked, 100);
 }
 
 // shaders/phong_fit.comp reads a sample's last word as raster | flags << 16 | resolution << 26.

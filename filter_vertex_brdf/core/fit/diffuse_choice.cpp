@@ -1,8 +1,15 @@
 #include "fit/diffuse_choice.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <deque>
+#include <utility>
+
+#include "base/mesh_adjacency.h"
+
+#include <vcg/space/index/kdtree/kdtree.h>
 
 namespace vbrdf {
 namespace {
@@ -11,6 +18,10 @@ constexpr int kFolds = 4;          // every 4th photo held out
 constexpr int kHeldOutFold = 3;
 constexpr size_t kMinPhotosSeen = 4;
 constexpr size_t kMinPilotVertices = 50;
+constexpr size_t kVoteNeighbours = 9;       // majority over the nearest labelled pilot vertices
+constexpr double kMinLabelShare = 0.05;     // a coat map needs each label on >= 5 % of the pilot
+
+enum MapLabel : int8_t { kUnlabelled = -1, kBare = 0, kCoated = 1 };
 
 bool held_out(const Sample &s) { return s.raster % kFolds == kHeldOutFold; }
 
@@ -34,18 +45,20 @@ std::vector<uint8_t> pilot_mask(const VisibilityMasks &masks, size_t target, siz
   return mask;
 }
 
-struct FormScore {
+// Per pilot vertex: held-out error sum and count under one form.
+struct PilotVertex {
+  uint32_t vertex = 0;
   double error = 0;
-  size_t samples = 0;
+  uint32_t samples = 0;
 };
 
-// Fits each pilot vertex on the training photos and scores it on the held-out ones.
-FormScore score_form(const MeshView &mesh, const std::vector<Raster> &rasters, const std::vector<LightSource> &lights,
-                     const VisibilityMasks &pilot, GatherSettings gather, DiffuseForm form, const PhongFitOptions &phong,
-                     PhotoCache &photos, const std::function<void(SampleChunk &)> &prepare) {
-  gather.diffuse = form;
+std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                    const std::vector<LightSource> &lights, const VisibilityMasks &pilot,
+                                    GatherSettings gather, DiffuseForm form, const PhongFitOptions &phong,
+                                    PhotoCache &photos, const std::function<void(SampleChunk &)> &prepare) {
+  gather.diffuse = DiffuseForms::everywhere(form);
   gather.resolution_weights = false;
-  FormScore score;
+  std::vector<PilotVertex> out;
   std::vector<Sample> train;
   gather_samples(mesh, rasters, lights, pilot, gather, photos, [&](SampleChunk &chunk) {
     if (prepare) prepare(chunk);
@@ -58,16 +71,66 @@ FormScore score_form(const MeshView &mesh, const std::vector<Raster> &rasters, c
       VertexFit fit;
       fit_vertex_cpu(train.data(), train.size(), phong, fit);
       if (!has_model(fit)) continue;
+      PilotVertex p;
+      p.vertex = chunk.first_vertex + i;
       for (const Sample *s = begin; s != end; ++s) {
         if (!held_out(*s) || !scorable(*s)) continue;
         float predicted[3];
         evaluate_phong(fit, s->d, s->lobe_cos, predicted);
-        for (int c = 0; c < 3; ++c) score.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;
-        ++score.samples;
+        for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;
+        ++p.samples;
       }
+      out.push_back(p);
     }
   });
-  return score;
+  return out;
+}
+
+// The coat map's label of each pilot vertex: coated where its kVoteNeighbours nearest other pilot
+// vertices (3-D distance, vcglib kd-tree; itself left out, so that the map's held-out score is not
+// its own choice) together predict their held-out photos better coated than Lambertian.
+std::vector<std::pair<uint32_t, MapLabel>> vote_labels(const MeshView &mesh, const std::vector<uint32_t> &vertex,
+                                                       const std::vector<double> &coated_gain) {
+  std::vector<vcg::Point3f> points(vertex.size());
+  for (size_t i = 0; i < vertex.size(); ++i) {
+    const float *q = mesh.positions + 3 * size_t(vertex[i]);
+    points[i] = vcg::Point3f(q[0], q[1], q[2]);
+  }
+  vcg::KdTree<float> tree(vcg::ConstDataWrapper<vcg::Point3f>(points.data(), int(points.size())));
+  const int k = int(std::min(kVoteNeighbours + 1, vertex.size()));
+  std::vector<std::pair<uint32_t, MapLabel>> labelled(vertex.size());
+  vcg::KdTree<float>::PriorityQueue queue;
+  for (size_t i = 0; i < vertex.size(); ++i) {
+    tree.doQueryK(points[i], k, queue);
+    double gain = 0;
+    for (int j = 0; j < queue.getNofElements(); ++j)
+      if (size_t(queue.getIndex(j)) != i) gain += coated_gain[size_t(queue.getIndex(j))];
+    labelled[i] = {vertex[i], gain > 0 ? kCoated : kBare};
+  }
+  return labelled;
+}
+
+// Every vertex takes the label of the nearest labelled one over the mesh's edges (breadth first
+// from all of them at once); vertices no label reaches take `fallback`.
+std::vector<uint8_t> spread_over_mesh(const MeshView &mesh, const std::vector<std::pair<uint32_t, MapLabel>> &labelled,
+                                      DiffuseForm fallback) {
+  const MeshAdjacency adj = build_mesh_adjacency(mesh);
+  std::vector<int8_t> label(mesh.vertex_count, kUnlabelled);
+  std::deque<uint32_t> front;
+  for (const auto &l : labelled)
+    if (label[l.first] == kUnlabelled) label[l.first] = l.second, front.push_back(l.first);
+  while (!front.empty()) {
+    const uint32_t v = front.front();
+    front.pop_front();
+    for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k) {
+      const uint32_t u = adj.neighbours[k];
+      if (label[u] == kUnlabelled) label[u] = label[v], front.push_back(u);
+    }
+  }
+  std::vector<uint8_t> coated(mesh.vertex_count);
+  for (size_t v = 0; v < coated.size(); ++v)
+    coated[v] = label[v] == kUnlabelled ? uint8_t(fallback == DiffuseForm::Coated) : uint8_t(label[v] == kCoated);
+  return coated;
 }
 
 std::string format_error(double e) {
@@ -78,11 +141,11 @@ std::string format_error(double e) {
 
 } // namespace
 
-DiffuseChoice choose_diffuse_form(const MeshView &mesh, const std::vector<Raster> &rasters,
-                                  const std::vector<LightSource> &lights, const VisibilityMasks &masks,
-                                  const GatherSettings &gather, const PhongFitOptions &phong, PhotoCache &photos,
-                                  const std::function<void(SampleChunk &)> &prepare,
-                                  const DiffuseChoiceOptions &options) {
+DiffuseChoice choose_diffuse_forms(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                   const std::vector<LightSource> &lights, const VisibilityMasks &masks,
+                                   const GatherSettings &gather, const PhongFitOptions &phong, PhotoCache &photos,
+                                   const std::function<void(SampleChunk &)> &prepare,
+                                   const DiffuseChoiceOptions &options) {
   const auto start = std::chrono::steady_clock::now();
   DiffuseChoice choice;
   size_t seeing = 0;
@@ -98,21 +161,65 @@ DiffuseChoice choose_diffuse_form(const MeshView &mesh, const std::vector<Raster
     return choice;
   }
   restrict_to_vertices(pilot, mask);
-  const FormScore lambert = score_form(mesh, rasters, lights, pilot, gather, DiffuseForm::Lambert, phong, photos, prepare);
-  const FormScore coated = score_form(mesh, rasters, lights, pilot, gather, DiffuseForm::Coated, phong, photos, prepare);
+  const std::vector<PilotVertex> lambert =
+      score_form(mesh, rasters, lights, pilot, gather, DiffuseForm::Lambert, phong, photos, prepare);
+  const std::vector<PilotVertex> coated =
+      score_form(mesh, rasters, lights, pilot, gather, DiffuseForm::Coated, phong, photos, prepare);
   choice.piloted = true;
-  choice.scored_samples = lambert.samples;
-  choice.heldout_error[0] = lambert.samples ? lambert.error / double(lambert.samples) : 0.0;
-  choice.heldout_error[1] = coated.samples ? coated.error / double(coated.samples) : 0.0;
-  const bool coat = lambert.samples > 0 && coated.samples > 0 &&
-                    choice.heldout_error[1] < (1.0 - options.margin) * choice.heldout_error[0];
-  choice.form = coat ? DiffuseForm::Coated : DiffuseForm::Lambert;
+
+  // Per-vertex errors side by side (both lists are in vertex order; a vertex modelled under one
+  // form only is left out of every candidate's score).
+  std::vector<std::pair<const PilotVertex *, const PilotVertex *>> both;
+  for (size_t i = 0, j = 0; i < lambert.size() && j < coated.size();) {
+    if (lambert[i].vertex < coated[j].vertex) ++i;
+    else if (coated[j].vertex < lambert[i].vertex) ++j;
+    else {
+      if (lambert[i].samples == coated[j].samples && lambert[i].samples > 0) both.push_back({&lambert[i], &coated[j]});
+      ++i, ++j;
+    }
+  }
+  double sum[2] = {0, 0};
+  for (const auto &b : both) sum[0] += b.first->error, sum[1] += b.second->error, choice.scored_samples += b.first->samples;
+  const double n = double(std::max<size_t>(choice.scored_samples, 1));
+  choice.heldout_error[0] = sum[0] / n, choice.heldout_error[1] = sum[1] / n;
+  const bool scored = choice.scored_samples > 0;
+  const DiffuseForm uniform = scored && choice.heldout_error[1] < (1.0 - options.margin) * choice.heldout_error[0]
+                                  ? DiffuseForm::Coated
+                                  : DiffuseForm::Lambert;
+  choice.forms = DiffuseForms::everywhere(uniform);
+
+  // The coat map.
+  std::string map_note = "no coat map (";
+  std::vector<uint32_t> pilot_vertex;
+  std::vector<double> coated_gain;
+  for (const auto &b : both) pilot_vertex.push_back(b.first->vertex), coated_gain.push_back(b.first->error - b.second->error);
+  const std::vector<std::pair<uint32_t, MapLabel>> labelled =
+      pilot_vertex.size() > kVoteNeighbours ? vote_labels(mesh, pilot_vertex, coated_gain)
+                                            : std::vector<std::pair<uint32_t, MapLabel>>();
+  size_t glossy = 0;
+  for (const auto &l : labelled) glossy += l.second == kCoated;
+  const double share = labelled.empty() ? 0.0 : double(glossy) / double(labelled.size());
+  if (scored && share >= kMinLabelShare && share <= 1.0 - kMinLabelShare) {
+    auto map = std::make_shared<std::vector<uint8_t>>(spread_over_mesh(mesh, labelled, uniform));
+    double map_sum = 0;  // each pilot vertex under its own (leave-one-out) label
+    for (size_t i = 0; i < both.size(); ++i) map_sum += labelled[i].second == kCoated ? both[i].second->error : both[i].first->error;
+    choice.heldout_error[2] = map_sum / n;
+    const double reference = choice.heldout_error[uniform == DiffuseForm::Coated ? 1 : 0];
+    if (choice.heldout_error[2] < (1.0 - options.map_margin) * reference) choice.forms = DiffuseForms{uniform, map};
+    map_note = "coat map " + format_error(choice.heldout_error[2]) + ", coated on " + std::to_string(glossy) + " of " +
+               std::to_string(labelled.size()) + " pilot vertices; it must be " + format_error(100 * options.map_margin) +
+               " % lower than the uniform choice)";
+  } else {
+    map_note += labelled.empty() ? "too few scored pilot vertices)"
+                                 : "the pilot vertices' neighbourhoods favour coated on " + std::to_string(glossy) +
+                                       " of " + std::to_string(labelled.size()) + ": one form)";
+  }
   choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  choice.note = std::string(diffuse_form_name(choice.form)) + " (Auto: pilot fit of " +
-                std::to_string(choice.pilot_vertices) + " vertices, every 4th photo held out, " +
-                std::to_string(choice.scored_samples) + " held-out samples: mean absolute error lambert " +
-                format_error(choice.heldout_error[0]) + ", coated " + format_error(choice.heldout_error[1]) +
-                "; coated must be " + format_error(100 * options.margin) + " % lower)";
+  choice.note = describe_diffuse_forms(choice.forms) + " (Auto: pilot fit of " + std::to_string(choice.pilot_vertices) +
+                " vertices, every 4th photo held out, " + std::to_string(choice.scored_samples) +
+                " held-out samples: mean absolute error lambert " + format_error(choice.heldout_error[0]) +
+                ", coated " + format_error(choice.heldout_error[1]) + " (coated must be " +
+                format_error(100 * options.margin) + " % lower), " + map_note + ")";
   return choice;
 }
 

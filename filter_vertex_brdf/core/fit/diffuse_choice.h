@@ -1,9 +1,13 @@
 #pragma once
-// Chooses the diffuse term's form (diffuse_form.h) for a scene from its own photos: a pilot fit of
-// a subset of the vertices under each form, every 4th photo held out, and the form whose fits
-// predict the held-out photos better is used for the real fit. Light-side evidence suffices: by
-// reciprocity the coat's transmission has the same curve for light and view, and the held-out
-// photos differ from the training ones in their lights.
+// Chooses the diffuse term's form (diffuse_form.h) from the scene's own photos: a pilot fit of a
+// subset of the vertices under each form, every 4th photo held out; the forms whose fits predict
+// the held-out photos best are used for the real fit. Light-side evidence suffices: by reciprocity
+// the coat's transmission has the same curve for light and view, and the held-out photos differ
+// from the training ones in their lights.
+//
+// Three candidates: Lambert everywhere, coated everywhere, and a coat map: coated where the photos
+// favour the coat, Lambert elsewhere (a scene may hold both, e.g. a varnished part beside bare stone,
+// or the two materials of bunny_two_materials_dir32).
 //
 // Contract:
 // - Pilot vertices: every k-th vertex among those seen by at least 4 photos, k chosen for about
@@ -13,10 +17,16 @@
 //   every photo in memory this costs no decoding), passed through `prepare` (the same colour
 //   correction and light fall-off as the fit), fitted on the photos with raster % 4 != 3 by the
 //   CPU reference (fit_vertex_cpu), and scored on the usable samples (lit, unsaturated, clean,
-//   d > 0) of the photos with raster % 4 == 3: mean absolute RGB error over all pilot vertices.
-// - Coated is chosen only when its held-out error is below (1 - margin) x Lambert's: the thesis's
-//   form stays where the data do not ask for the coat. Errors are finite sums (non-finite samples
-//   are skipped by the fit's rules and the scoring's); with no scored sample Lambert is kept.
+//   d > 0) of the photos with raster % 4 == 3: mean absolute RGB error.
+// - Coat map: a pilot vertex is labelled coated when its 9 nearest other pilot vertices (3-D
+//   distance; itself left out) together predict their held-out photos better coated than
+//   Lambertian; every mesh vertex then takes the label of the nearest pilot vertex over the mesh's
+//   edges (components no pilot vertex reaches: the uniform choice). The map's held-out error is
+//   that of each pilot vertex under its own label, which its own error did not decide.
+// - Choice: coated everywhere only when its error is below (1 - margin) x Lambert's; the coat map
+//   only when it holds both labels on >= 5 % of the pilot vertices each and its error is below
+//   (1 - map_margin) x the uniform choice's. Errors are finite sums (non-finite samples are skipped
+//   by the fit's rules and the scoring's); with no scored sample Lambert is kept.
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -31,24 +41,26 @@
 namespace vbrdf {
 
 struct DiffuseChoice {
-  DiffuseForm form = DiffuseForm::Lambert;
+  DiffuseForms forms;            // the choice (uniform, or a per-vertex coat map)
   bool piloted = false;          // false: no pilot ran (note says why)
   size_t pilot_vertices = 0;
-  size_t scored_samples = 0;     // held-out samples scored (the same set for both forms)
-  double heldout_error[2] = {0, 0};  // per form (index = DiffuseForm): mean absolute RGB error
+  size_t scored_samples = 0;     // held-out samples scored (the same set for every candidate)
+  double heldout_error[3] = {0, 0, 0};  // Lambert, coated, coat map: mean absolute RGB error (map: 0 if not tried)
   double seconds = 0;
   std::string note;              // one line for the report and the log
 };
 
 struct DiffuseChoiceOptions {
   size_t pilot_vertices = 3000;
-  double margin = 0.10;  // relative improvement the coated form must show (see README "The diffuse term's form")
+  double margin = 0.10;      // relative improvement coated everywhere must show over Lambert (README
+                             //   "The diffuse term's form")
+  double map_margin = 0.05;  // relative improvement the coat map must show over the uniform choice
 };
 
-DiffuseChoice choose_diffuse_form(const MeshView &mesh, const std::vector<Raster> &rasters,
-                                  const std::vector<LightSource> &lights, const VisibilityMasks &masks,
-                                  const GatherSettings &gather, const PhongFitOptions &phong, PhotoCache &photos,
-                                  const std::function<void(SampleChunk &)> &prepare,
-                                  const DiffuseChoiceOptions &options = DiffuseChoiceOptions());
+DiffuseChoice choose_diffuse_forms(const MeshView &mesh, const std::vector<Raster> &rasters,
+                                   const std::vector<LightSource> &lights, const VisibilityMasks &masks,
+                                   const GatherSettings &gather, const PhongFitOptions &phong, PhotoCache &photos,
+                                   const std::function<void(SampleChunk &)> &prepare,
+                                   const DiffuseChoiceOptions &options = DiffuseChoiceOptions());
 
 } // namespace vbrdf

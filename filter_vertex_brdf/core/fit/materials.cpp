@@ -1,5 +1,7 @@
 #include "fit/materials.h"
 
+#include "base/mesh_adjacency.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -245,28 +247,7 @@ std::vector<LobeFit> fit_lobes(const Context &c, int set, const std::vector<Stat
   return fit;
 }
 
-// Compressed vertex adjacency.
-struct Adjacency {
-  std::vector<uint32_t> start, list;
-};
-Adjacency build_adjacency(const MeshView &mesh) {
-  std::vector<std::vector<uint32_t>> nb(mesh.vertex_count);
-  for (size_t t = 0; t + 2 < mesh.index_count; t += 3)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = mesh.indices[t + size_t(k)], b = mesh.indices[t + size_t((k + 1) % 3)];
-      if (a >= mesh.vertex_count || b >= mesh.vertex_count || a == b) continue;
-      nb[a].push_back(b), nb[b].push_back(a);
-    }
-  Adjacency adj;
-  adj.start.push_back(0);
-  for (auto &l : nb) {
-    std::sort(l.begin(), l.end());
-    l.erase(std::unique(l.begin(), l.end()), l.end());
-    adj.list.insert(adj.list.end(), l.begin(), l.end());
-    adj.start.push_back(uint32_t(adj.list.size()));
-  }
-  return adj;
-}
+using Adjacency = MeshAdjacency;
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -279,7 +260,7 @@ double median_of(std::vector<double> v) {
 // no label reaches takes its data's best label.
 void spread_labels(const Context &c, const Adjacency &adj, const std::vector<std::vector<double>> &cost, int K,
                    std::vector<int32_t> &label) {
-  const size_t n = adj.start.size() - 1;
+  const size_t n = adj.offsets.size() - 1;
   std::vector<int32_t> lab(n, 0);
   for (size_t v = 0; v < std::min(n, c.n); ++v) lab[v] = c.eligible[v] ? label[v] : 0;
   std::vector<int> count(size_t(K) + 1);
@@ -289,8 +270,8 @@ void spread_labels(const Context &c, const Adjacency &adj, const std::vector<std
     for (size_t v = 0; v < n; ++v) {
       if (lab[v] > 0) continue;
       std::fill(count.begin(), count.end(), 0);
-      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k)
-        if (lab[adj.list[k]] > 0) ++count[size_t(lab[adj.list[k]])];
+      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
+        if (lab[adj.neighbours[k]] > 0) ++count[size_t(lab[adj.neighbours[k]])];
       const int best = int(std::max_element(count.begin() + 1, count.end()) - count.begin());
       if (count[size_t(best)] > 0) next[v] = best, grew = true;
     }
@@ -350,8 +331,8 @@ void assign_labels(const Context &c, const Adjacency &adj, const std::vector<Sta
       if (!decides[v]) continue;
       std::fill(count.begin(), count.end(), 0);
       int labelled = 0;
-      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k) {
-        const int32_t l = label[adj.list[k]];
+      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k) {
+        const int32_t l = label[adj.neighbours[k]];
         if (l > 0 && l <= K) ++count[size_t(l)], ++labelled;
       }
       int best = label[v] > 0 && label[v] <= K ? label[v] : 1;
@@ -640,7 +621,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     const float s = store.entries()[k].s;
     c.log_s[k] = s > 0 ? std::log(std::min(s, 1.0f)) : 1.0f;
   }
-  const Adjacency adj = build_adjacency(mesh);
+  const Adjacency adj = build_mesh_adjacency(mesh);
   std::ostringstream rep;
 
   // 1. Choose K and the prior on the training photos, by the error at the held-out ones.
@@ -765,15 +746,15 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
 
 void propagate_material_labels(const MeshView &mesh, const std::vector<VertexFit> &fits, std::vector<int32_t> &label) {
   const size_t n = std::min({mesh.vertex_count, fits.size(), label.size()});
-  const Adjacency adj = build_adjacency(mesh);
+  const Adjacency adj = build_mesh_adjacency(mesh);
   for (int pass = 0; pass < 1000; ++pass) {
     std::vector<int32_t> next = label;
     size_t changed = 0;
     for (size_t v = 0; v < n; ++v) {
       if (label[v] > 0 || !has_model(fits[v])) continue;
       std::vector<int32_t> seen;
-      for (uint32_t k = adj.start[v]; k < adj.start[v + 1]; ++k)
-        if (adj.list[k] < n && label[adj.list[k]] > 0) seen.push_back(label[adj.list[k]]);
+      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
+        if (adj.neighbours[k] < n && label[adj.neighbours[k]] > 0) seen.push_back(label[adj.neighbours[k]]);
       if (seen.empty()) continue;
       std::sort(seen.begin(), seen.end());
       int32_t best = seen[0];

@@ -1,4 +1,5 @@
 #include "fit/neighbour_fill.h"
+#include "base/mesh_adjacency.h"
 #include "base/vec3.h"
 
 #include <algorithm>
@@ -11,45 +12,7 @@ namespace vbrdf {
 
 namespace {
 
-// Compressed vertex adjacency (each undirected edge stored in both directions, duplicates removed).
-struct Adjacency {
-  std::vector<uint32_t> offsets, neighbours;
-};
-
-Adjacency build_adjacency(const MeshView &mesh) {
-  const size_t n = mesh.vertex_count;
-  std::vector<uint32_t> degree(n + 1, 0);
-  for (size_t i = 0; i + 2 < mesh.index_count; i += 3)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = mesh.indices[i + e], b = mesh.indices[i + (e + 1) % 3];
-      if (a < n && b < n && a != b) ++degree[a], ++degree[b];
-    }
-  Adjacency adj;
-  adj.offsets.assign(n + 1, 0);
-  for (size_t v = 0; v < n; ++v) adj.offsets[v + 1] = adj.offsets[v] + degree[v];
-  adj.neighbours.resize(adj.offsets[n]);
-  std::vector<uint32_t> fill(adj.offsets.begin(), adj.offsets.end() - 1);
-  for (size_t i = 0; i + 2 < mesh.index_count; i += 3)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = mesh.indices[i + e], b = mesh.indices[i + (e + 1) % 3];
-      if (a < n && b < n && a != b) adj.neighbours[fill[a]++] = b, adj.neighbours[fill[b]++] = a;
-    }
-  // Deduplicate each list in place (an interior edge appears in two triangles).
-  std::vector<uint32_t> offsets(n + 1, 0);
-  size_t out = 0;
-  for (size_t v = 0; v < n; ++v) {
-    auto first = adj.neighbours.begin() + adj.offsets[v], last = adj.neighbours.begin() + adj.offsets[v + 1];
-    std::sort(first, last);
-    last = std::unique(first, last);
-    offsets[v] = uint32_t(out);
-    for (auto it = first; it != last; ++it) adj.neighbours[out++] = *it;
-  }
-  offsets[n] = uint32_t(out);
-  adj.neighbours.resize(out);
-  adj.offsets.swap(offsets);
-  return adj;
-}
-
+using Adjacency = MeshAdjacency;
 
 // The weighted average of the modelled neighbours of v (model[u] != 0); false when there is none.
 bool average_of_neighbours(const MeshView &mesh, const Adjacency &adj, const std::vector<uint8_t> &model,
@@ -96,7 +59,7 @@ NeighbourFillStats fill_from_neighbours(const MeshView &mesh, const uint8_t *see
     missing += !model[v] && seen[v];
   }
   if (missing == 0 && unseen_rings <= 0) return stats;
-  const Adjacency adj = build_adjacency(mesh);
+  const Adjacency adj = build_mesh_adjacency(mesh);
   const float min_length = 1e-6f * std::max(compute_bounds(mesh).diagonal(), 1e-30f);
   std::vector<uint32_t> front;
   std::vector<VertexFit> filled;

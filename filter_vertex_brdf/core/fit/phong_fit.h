@@ -4,7 +4,8 @@
 //
 // Model, per colour channel c, light of unit irradiance and white colour (after calibration):
 //     f_c = k_d d C_c + k_s max(s, 0)^alpha,  s = R.E or N.H (options.lobe, samples/lobe.h),
-//     d = N.L, or N.L with the coat's Fresnel transmission (options.diffuse, samples/diffuse_form.h)
+//     d = N.L, or N.L with the coat's Fresnel transmission (Sample::d: the gatherer's diffuse form,
+//     samples/diffuse_form.h; the fit never evaluates the form itself)
 // Objective: sum over usable samples i of w_i * sum_c (P_ic - f_c)^2 + prior, with
 //     w_i = d_i (N.L_i in the thesis, ch. 5) times the sample's photo resolution weight (resolution_weight,
 //     1 with one camera), highlight samples rescaled so that their total weight is at
@@ -62,10 +63,6 @@ struct PhongFitOptions {
   // The lobe's form: which cosine Sample::lobe_cos holds and alpha applies to (lobe.h). The
   // thresholds above stay stated on R.E and are converted by lobe_threshold().
   LobeForm lobe = LobeForm::PhongRE;
-  // The diffuse term's form (diffuse_form.h). The fit itself never evaluates it: the samples carry
-  // d already (Sample::d; pipeline.cpp copies this into GatherSettings::diffuse); the result and the
-  // renderers take it from here.
-  DiffuseForm diffuse = DiffuseForm::Lambert;
 };
 
 enum FitStatus : uint8_t {

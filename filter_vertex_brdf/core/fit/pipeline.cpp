@@ -136,21 +136,22 @@ void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &
 } // namespace
 
 namespace {
-// Sets settings.phong.diffuse and settings.gather.diffuse (one diffuse form for the samples, the fit
-// and the result) from settings.diffuse_choice; Auto runs the pilot of diffuse_choice.h.
+// Sets settings.gather.diffuse (the diffuse forms of the samples, hence of the fit and the result)
+// from settings.diffuse_choice; Auto runs the pilot of diffuse_choice.h.
 void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &lights, const VisibilityMasks &masks,
                          PhotoCache &photos, const std::function<void(SampleChunk &)> &prepare, const LogFn &log,
                          FitSettings &settings, FitResult &result) {
   if (!settings.fit_reflectance || settings.diffuse_choice != DiffuseTermChoice::Auto) {
-    result.diffuse_form = settings.diffuse_choice == DiffuseTermChoice::Coated ? DiffuseForm::Coated : DiffuseForm::Lambert;
-    result.diffuse_choice_note = std::string(diffuse_form_name(result.diffuse_form)) +
+    result.diffuse_forms = DiffuseForms::everywhere(
+        settings.diffuse_choice == DiffuseTermChoice::Coated ? DiffuseForm::Coated : DiffuseForm::Lambert);
+    result.diffuse_choice_note = describe_diffuse_forms(result.diffuse_forms) +
                                  (settings.fit_reflectance ? " (as set)" : " (no Phong fit: the thesis's form)");
   } else {
     const size_t loads_before = photos.loads();
     const DiffuseChoice choice =
-        choose_diffuse_form(input.mesh, input.rasters, lights, masks, settings.gather, settings.phong, photos, prepare);
+        choose_diffuse_forms(input.mesh, input.rasters, lights, masks, settings.gather, settings.phong, photos, prepare);
     const size_t decoded_again = photos.loads() - loads_before;
-    result.diffuse_form = choice.form;
+    result.diffuse_forms = choice.forms;
     result.diffuse_choice_note = choice.note + (choice.piloted ? ", " + fixed(choice.seconds) + " s" : "") +
                                  (decoded_again ? ", " + std::to_string(decoded_again) +
                                                       " photo decodes (the photos exceed 'Photo memory (MB)'; "
@@ -158,7 +159,7 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
                                                 : "");
     log("Vertex BRDF: diffuse term " + result.diffuse_choice_note + ".");
   }
-  settings.phong.diffuse = settings.gather.diffuse = result.diffuse_form;
+  settings.gather.diffuse = result.diffuse_forms;
 }
 } // namespace
 

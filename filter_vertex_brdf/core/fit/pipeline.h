@@ -54,8 +54,7 @@ struct FitSettings {
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;
   bool fit_reflectance = true;         // false: basic diffuse colour only (no k_d/k_s/alpha)
-  PhongFitOptions phong;               // its specular_threshold is taken from gather; its diffuse
-                                       //   form from diffuse_choice
+  PhongFitOptions phong;               // its specular_threshold is taken from gather
   DiffuseTermChoice diffuse_choice = kFitDiffuseChoice;
   FitBackendChoice fit_backend = FitBackendChoice::Auto;
   QualityOutput quality = QualityOutput::DQ;  // what goes into vertex quality
@@ -116,7 +115,7 @@ struct FitResult {
   size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
   NeighbourFillStats fill;
   MaterialResult materials;               // material stage (FitSettings::materials); label empty when off
-  DiffuseForm diffuse_form = DiffuseForm::Lambert;  // the form fitted (FitSettings::diffuse_choice)
+  DiffuseForms diffuse_forms;             // the forms fitted, per vertex where they vary (FitSettings::diffuse_choice)
   std::string diffuse_choice_note;        // how it was decided (report line; diffuse_choice.h for Auto)
   double seconds_fit = 0;
   std::string light_file;                 // the light file used (.lp, .json or .dome)

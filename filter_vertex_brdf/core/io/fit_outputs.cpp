@@ -106,7 +106,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       const VertexFit &f = r.fits[v];
       rec.fit = f;
       rec.lobe_form = float(uint8_t(settings.phong.lobe));
-      rec.diffuse_form = float(uint8_t(r.diffuse_form));
+      rec.diffuse_form = float(uint8_t(r.diffuse_forms.at(v)));
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -164,7 +164,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   if (settings.fit_reflectance)
     rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
         << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
-        << "); diffuse term: " << r.diffuse_choice_note << ", per-vertex diffuse_form = " << int(r.diffuse_form)
+        << "); diffuse term: " << r.diffuse_choice_note << " (per-vertex diffuse_form: 0 lambert, 1 coated)"
         << "; samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off") << "\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"

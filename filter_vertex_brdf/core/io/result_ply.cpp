@@ -115,7 +115,7 @@ ResultPly read_result_ply(const std::string &path) {
 }
 
 std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe,
-                                        DiffuseForm *diffuse) {
+                                        DiffuseForms *diffuse) {
   const std::string missing = first_missing_model_attribute(result.vertex_properties);
   if (!missing.empty())
     throw InputError("Result '" + path + "' has no per-vertex '" + missing +
@@ -124,7 +124,7 @@ std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::stri
   const std::vector<VertexRecord> records = records_from_columns(result.vertex_properties, path);
   for (const VertexRecord &record : records) fits.push_back(record.fit);
   if (lobe) *lobe = lobe_form_of(records, path);
-  if (diffuse) *diffuse = diffuse_form_of(records, path);
+  if (diffuse) *diffuse = diffuse_forms_of(records);
   return fits;
 }
 

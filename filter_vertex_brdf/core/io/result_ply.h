@@ -26,8 +26,8 @@ ResultPly read_result_ply(const std::string &path);
 // Throws InputError naming the first missing attribute needed for the model (kd, ks, shininess,
 // color_r/g/b, fit_status), or a column of the wrong length.
 // `lobe` and `diffuse` (optional) receive the result's lobe and diffuse forms (lobe_form_of,
-// diffuse_form_of).
+// diffuse_forms_of).
 std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe = nullptr,
-                                        DiffuseForm *diffuse = nullptr);
+                                        DiffuseForms *diffuse = nullptr);
 
 } // namespace vbrdf

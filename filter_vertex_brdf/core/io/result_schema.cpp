@@ -64,8 +64,8 @@ std::vector<ResultAttribute> make_schema() {
        "(absent: 0)",
        [](const R &r) { return r.lobe_form; }, [](R &r, float v) { r.lobe_form = whole(v, 1.0f); }},
       {"diffuse_form", K::Code, G::PhongFit, false,
-       "the diffuse term's form that kd multiplies: 0 Lambert (N.L, the thesis), 1 coated (N.L with a clear "
-       "coat's Fresnel transmission in and out, index 1.5) (absent: 0)",
+       "the diffuse term's form that kd multiplies at the vertex: 0 Lambert (N.L, the thesis), 1 coated (N.L with "
+       "a clear coat's Fresnel transmission in and out, index 1.5) (absent: 0)",
        [](const R &r) { return r.diffuse_form; }, [](R &r, float v) { r.diffuse_form = whole(v, 1.0f); }},
   };
 }
@@ -122,29 +122,24 @@ std::vector<VertexRecord> records_from_columns(const ResultColumns &columns, con
   return records;
 }
 
-namespace {
-// The one 0/1 code that the modelled vertices of a result share for a per-result form attribute.
-bool form_code_of(const std::vector<VertexRecord> &records, float VertexRecord::*code, const char *attribute,
-                  const char *what, const std::string &source) {
+LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
   bool seen[2] = {false, false};
   for (const VertexRecord &r : records)
-    if (has_model(r.fit)) seen[r.*code > 0.5f ? 1 : 0] = true;
+    if (has_model(r.fit)) seen[r.lobe_form > 0.5f ? 1 : 0] = true;
   if (seen[0] && seen[1])
-    throw InputError("Result '" + source + "' mixes " + what + " (per-vertex '" + attribute +
-                     "' 0 and 1): refit it in one run.");
-  return seen[1];
-}
-} // namespace
-
-LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
-  return form_code_of(records, &VertexRecord::lobe_form, "lobe_form", "lobe forms", source) ? LobeForm::BlinnNH
-                                                                                           : LobeForm::PhongRE;
+    throw InputError("Result '" + source + "' mixes lobe forms (per-vertex 'lobe_form' 0 and 1): refit it in one run.");
+  return seen[1] ? LobeForm::BlinnNH : LobeForm::PhongRE;
 }
 
-DiffuseForm diffuse_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
-  return form_code_of(records, &VertexRecord::diffuse_form, "diffuse_form", "diffuse forms", source)
-             ? DiffuseForm::Coated
-             : DiffuseForm::Lambert;
+DiffuseForms diffuse_forms_of(const std::vector<VertexRecord> &records) {
+  bool seen[2] = {false, false};
+  auto coated = std::make_shared<std::vector<uint8_t>>(records.size(), 0);
+  for (size_t v = 0; v < records.size(); ++v) {
+    (*coated)[v] = records[v].diffuse_form > 0.5f ? 1 : 0;
+    if (has_model(records[v].fit)) seen[(*coated)[v]] = true;
+  }
+  if (seen[0] && seen[1]) return DiffuseForms{DiffuseForm::Lambert, coated};
+  return DiffuseForms::everywhere(seen[1] ? DiffuseForm::Coated : DiffuseForm::Lambert);
 }
 
 } // namespace vbrdf

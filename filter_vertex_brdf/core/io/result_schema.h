@@ -23,7 +23,7 @@ struct VertexRecord {
   float coloured = 0.0f;  // 0 input colour kept, 1 clean pixels, 2 rim/mixed pixels only, 3 neighbours
   float material = 0.0f;  // material stage (materials.h): 1..K, 0 = none (stage off, or no model)
   float lobe_form = 0.0f;  // LobeForm of the fit (samples/lobe.h): 0 R.E, 1 N.H; one value per result
-  float diffuse_form = 0.0f;  // DiffuseForm of the fit (samples/diffuse_form.h): 0 Lambert, 1 coated; ditto
+  float diffuse_form = 0.0f;  // DiffuseForm at the vertex (samples/diffuse_form.h): 0 Lambert, 1 coated
   VertexFit fit = {{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0, kFitNone, 0};  // sentinels
 };
 
@@ -71,7 +71,8 @@ std::vector<VertexRecord> records_from_columns(const ResultColumns &columns, con
 // files written before the attribute existed). Throws InputError naming `source` when the
 // modelled vertices disagree.
 LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source);
-// The same for the diffuse form ('diffuse_form'; Lambert when absent).
-DiffuseForm diffuse_form_of(const std::vector<VertexRecord> &records, const std::string &source);
+// The diffuse forms of a result ('diffuse_form': Lambert when absent): uniform when every modelled
+// vertex has the same, else per vertex (a coat map, diffuse_choice.h).
+DiffuseForms diffuse_forms_of(const std::vector<VertexRecord> &records);
 
 } // namespace vbrdf

@@ -25,6 +25,7 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
 layout(location = 3) in vec2 a_ks_alpha;
 layout(location = 4) in vec3 a_status_dq_sq;
+layout(location = 5) in float a_coated;
 uniform mat4 u_modelview;
 uniform mat4 u_projection;
 uniform int u_display;
@@ -35,6 +36,7 @@ out vec3 v_normal;
 out vec4 v_rho_fitted;
 out vec2 v_ks_alpha;
 out vec3 v_false_color;
+out float v_coated;
 vec3 quality_color(float q) {  // live_legend.cpp quality_color
   float t = clamp(q, 0.0, 2.0);
   return t >= 1.0 ? mix(u_quality_stops[1], u_quality_stops[2], t - 1.0) : mix(u_quality_stops[0], u_quality_stops[1], t);
@@ -44,6 +46,7 @@ void main() {
   v_normal = a_normal;
   v_rho_fitted = a_rho_fitted;
   v_ks_alpha = a_ks_alpha;
+  v_coated = a_coated;
   if (u_display == 3) v_false_color = u_status_colors[int(clamp(a_status_dq_sq.x, 0.0, 4.0) + 0.5)];
   else if (u_display == 4) v_false_color = quality_color(a_status_dq_sq.y);
   else v_false_color = quality_color(a_status_dq_sq.z);
@@ -57,6 +60,7 @@ in vec3 v_normal;
 in vec4 v_rho_fitted;
 in vec2 v_ks_alpha;
 in vec3 v_false_color;
+in float v_coated;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
 uniform int u_eye_is_point;
@@ -90,14 +94,14 @@ void main() {
   vec3 e = u_eye_is_point != 0 ? normalize(u_eye - v_position) : u_eye;
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, n, l, e, diffuse, spec);
+  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, diffuse, spec);
   c = u_display == 1 ? diffuse : u_display == 2 ? vec3(spec) : diffuse + vec3(spec);
   c *= u_exposure;
   o_color = vec4(u_encode_srgb != 0 ? srgb(c) : c, 1.0);
 }
 )";
 
-constexpr int kFloatsPerVertex = 15;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, status/dq/sq 3
+constexpr int kFloatsPerVertex = 16;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, status/dq/sq 3, coated 1
 
 // Inverse of the upper-left 3x3 of a column-major 4x4; false when singular.
 bool invert_linear_part(const double m[16], double inv[9]) {
@@ -142,19 +146,18 @@ bool eye_to_world_direction(const double modelview[16], const double eye_directi
 class LiveRelight::Impl {
 public:
   Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc, LobeForm lobe,
-       DiffuseForm diffuse);
+       const DiffuseForms &diffuse);
   ~Impl() { release(); }
   void draw(const LiveView &view);
   std::vector<float> render_offscreen(const LiveView &view, int width, int height, bool read_back);
   size_t vertex_count = 0;
 
 private:
-  void upload(const MeshView &mesh, const std::vector<VertexFit> &fits);
+  void upload(const MeshView &mesh, const std::vector<VertexFit> &fits, const DiffuseForms &diffuse);
   void release();
 
   GlApi gl_;
   LobeForm lobe_;
-  DiffuseForm diffuse_;
   size_t index_count_ = 0;
   double origin_[3] = {0, 0, 0};
   GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
@@ -162,8 +165,8 @@ private:
 };
 
 LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc,
-                        LobeForm lobe, DiffuseForm diffuse)
-    : gl_(load_gl_api(get_proc)), lobe_(lobe), diffuse_(diffuse) {
+                        LobeForm lobe, const DiffuseForms &diffuse)
+    : gl_(load_gl_api(get_proc)), lobe_(lobe) {
   if (fits.size() != mesh.vertex_count)
     throw InputError("Live relighting: " + std::to_string(fits.size()) + " per-vertex fits for a mesh of " +
                      std::to_string(mesh.vertex_count) + " vertices: use the fit of this mesh.");
@@ -175,7 +178,7 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   try {
     program_ = build_program(gl_, kLiveVertexShader, phong_program_source(kLiveFragmentMain).c_str(),
                              "the live relighting pass");
-    upload(mesh, fits);
+    upload(mesh, fits, diffuse);
     check_gl_error(gl_, "the upload of the mesh for live relighting");
   } catch (...) {
     release();
@@ -183,7 +186,7 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   }
 }
 
-void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
+void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits, const DiffuseForms &diffuse) {
   const float alpha_default = typical_shininess(fits);
   std::vector<float> data(mesh.vertex_count * kFloatsPerVertex);
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
@@ -200,6 +203,7 @@ void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit
     o[12] = float(f.status);
     o[13] = std::isfinite(f.dq) ? f.dq : 0.0f;
     o[14] = std::isfinite(f.sq) ? f.sq : 0.0f;
+    o[15] = diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
   }
   index_count_ = mesh.index_count;
   gl_.GenVertexArrays(1, &vao_);
@@ -208,8 +212,8 @@ void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[5] = {3, 3, 4, 2, 3}, offsets[5] = {0, 3, 6, 10, 12};
-  for (GLuint a = 0; a < 5; ++a) {
+  const int sizes[6] = {3, 3, 4, 2, 3, 1}, offsets[6] = {0, 3, 6, 10, 12, 15};
+  for (GLuint a = 0; a < 6; ++a) {
     gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
                             reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
     gl_.EnableVertexAttribArray(a);
@@ -278,7 +282,7 @@ void LiveRelight::Impl::draw(const LiveView &view) {
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_display"), int(view.display));
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_exposure"), std::isfinite(view.exposure) ? view.exposure : 1.0f);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_encode_srgb"), view.encode_srgb ? 1 : 0);
-  set_phong_model_uniforms(gl_, p, lobe_, diffuse_);
+  set_phong_model_uniforms(gl_, p, lobe_);
   std::vector<float> colors;
   for (const LegendEntry &e : fit_status_legend()) colors.insert(colors.end(), e.rgb.begin(), e.rgb.end());
   gl_.Uniform3fv(gl_.GetUniformLocation(p, "u_status_colors"), GLsizei(colors.size() / 3), colors.data());
@@ -320,7 +324,7 @@ std::vector<float> LiveRelight::Impl::render_offscreen(const LiveView &view, int
 }
 
 LiveRelight::LiveRelight(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc,
-                         LobeForm lobe, DiffuseForm diffuse)
+                         LobeForm lobe, const DiffuseForms &diffuse)
     : impl_(new Impl(mesh, fits, get_proc, lobe, diffuse)) {}
 LiveRelight::~LiveRelight() = default;
 void LiveRelight::draw(const LiveView &view) { impl_->draw(view); }

@@ -18,9 +18,8 @@ std::string phong_program_source(const char *body) {
   return std::string("#version 330 core\n#line 1 1\n") + model + "\n#line 1 2\n" + body;
 }
 
-void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe, DiffuseForm diffuse) {
+void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe) {
   gl.Uniform1i(gl.GetUniformLocation(program, "u_half_angle_lobe"), lobe == LobeForm::BlinnNH ? 1 : 0);
-  gl.Uniform1i(gl.GetUniformLocation(program, "u_coated_diffuse"), diffuse == DiffuseForm::Coated ? 1 : 0);
   gl.Uniform1f(gl.GetUniformLocation(program, "u_coat_index"), kCoatIndex);
   gl.Uniform1f(gl.GetUniformLocation(program, "u_coat_min_n_dot_e"), kCoatMinNdotE);
 }

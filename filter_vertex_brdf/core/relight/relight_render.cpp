@@ -38,12 +38,14 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
 layout(location = 3) in vec2 a_ks_alpha;
+layout(location = 4) in float a_coated;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_rho_fitted;
 out vec2 v_ks_alpha;
+out float v_coated;
 out float v_depth;
 void main() {
   vec4 view_pos = u_view * vec4(a_position, 1.0);
@@ -51,6 +53,7 @@ void main() {
   v_normal = a_normal;
   v_rho_fitted = a_rho_fitted;
   v_ks_alpha = a_ks_alpha;
+  v_coated = a_coated;
   v_depth = -view_pos.z;
   gl_Position = u_projection * view_pos;
 }
@@ -66,6 +69,7 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec4 v_rho_fitted;
 in vec2 v_ks_alpha;
+in float v_coated;
 in float v_depth;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
@@ -115,12 +119,12 @@ void main() {
   vec3 e = normalize(u_eye - v_position);
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, n, l, e, diffuse, spec);
+  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, diffuse, spec);
   o_color = vec4((diffuse + vec3(spec)) * irradiance, 1.0);
 }
 )";
 
-constexpr int kFloatsPerVertex = 12;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1
+constexpr int kFloatsPerVertex = 13;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, coated 1
 
 void normalise(const float in[3], float out[3], const char *what) {
   const double len = std::sqrt(double(in[0]) * in[0] + double(in[1]) * in[1] + double(in[2]) * in[2]);
@@ -200,6 +204,7 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
     o[9] = f.status == kFitNone ? 0.0f : 1.0f;
     o[10] = f.ks;
     o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
+    o[12] = settings_.diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
   }
   index_count_ = mesh.index_count;
 
@@ -209,8 +214,8 @@ void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<Verte
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[4] = {3, 3, 4, 2}, offsets[4] = {0, 3, 6, 10};
-  for (GLuint a = 0; a < 4; ++a) {
+  const int sizes[5] = {3, 3, 4, 2, 1}, offsets[5] = {0, 3, 6, 10, 12};
+  for (GLuint a = 0; a < 5; ++a) {
     gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
                             reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
     gl_.EnableVertexAttribArray(a);
@@ -300,7 +305,7 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, projection.m);
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
-  set_phong_model_uniforms(gl_, p, settings_.lobe, settings_.diffuse);
+  set_phong_model_uniforms(gl_, p, settings_.lobe);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), lv.scale);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_light_perspective"), lv.perspective ? 1 : 0);

@@ -57,7 +57,7 @@ struct RelightRenderSettings {
                                   // fit's visibility pass (resolved_shadow_map_size)
   float depth_tolerance = 0.002f; // shadow test slack, fraction of the bounding-box diagonal
   LobeForm lobe = LobeForm::PhongRE;  // the fit's lobe form (its result's lobe_form; lobe.h)
-  DiffuseForm diffuse = DiffuseForm::Lambert;  // the fit's diffuse form (its result's diffuse_form; diffuse_form.h)
+  DiffuseForms diffuse;  // the fit's diffuse forms, per vertex where they vary (its result's diffuse_form; diffuse_form.h)
 };
 
 // Renders one mesh with its per-vertex fits (one VertexFit per vertex). The mesh and the fits are

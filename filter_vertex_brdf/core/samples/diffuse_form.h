@@ -26,7 +26,9 @@
 // header comment).
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 namespace vbrdf {
 
@@ -61,6 +63,28 @@ inline float diffuse_factor(DiffuseForm f, float n_dot_l, float n_dot_e) {
   if (f == DiffuseForm::Lambert || !(n_dot_l > 0)) return n_dot_l;
   const float t1 = coat_transmission(1.0f);
   return n_dot_l * coat_transmission(n_dot_l) * coat_transmission(std::fmax(n_dot_e, kCoatMinNdotE)) / (t1 * t1);
+}
+
+// The form over a mesh: one form everywhere, or, where a coated material lies beside a bare one
+// (diffuse_choice.h's coat map), one per vertex.
+struct DiffuseForms {
+  DiffuseForm uniform = DiffuseForm::Lambert;            // where `coated` is null or too short
+  std::shared_ptr<const std::vector<uint8_t>> coated;  // per vertex: 1 coated, 0 Lambert; null: uniform
+  DiffuseForm at(size_t v) const {
+    if (coated && v < coated->size()) return (*coated)[v] ? DiffuseForm::Coated : DiffuseForm::Lambert;
+    return uniform;
+  }
+  bool varies() const { return coated != nullptr; }
+  static DiffuseForms everywhere(DiffuseForm f) { return DiffuseForms{f, nullptr}; }
+};
+
+// "lambert", "coated", or "coated on N of M vertices" (report).
+inline std::string describe_diffuse_forms(const DiffuseForms &forms) {
+  if (!forms.varies()) return diffuse_form_name(forms.uniform);
+  size_t n = 0;
+  for (uint8_t c : *forms.coated) n += c != 0;
+  return "coated on " + std::to_string(n) + " of " + std::to_string(forms.coated->size()) +
+         " vertices, lambert elsewhere";
 }
 
 } // namespace vbrdf

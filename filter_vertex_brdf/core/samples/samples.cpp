@@ -174,7 +174,7 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
   light_direction_at(light, position, light_dir);
   const float d = dot3(n, light_dir);
   const float s = lobe_cosine(LobeForm::PhongRE, n, light_dir, e);  // R.E: decides kHighlight
-  out.d = diffuse_factor(settings.diffuse, d, dot3(n, e));
+  out.d = diffuse_factor(settings.diffuse.uniform, d, dot3(n, e));
   out.lobe_cos = settings.lobe == LobeForm::PhongRE ? s : lobe_cosine(settings.lobe, n, light_dir, e);
   if (d <= 0) flags |= kAttachedShadow;
   if (!light_clear) flags |= kCastShadow;
@@ -216,6 +216,14 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
   if (rasters.size() > 65535) throw InputError("More than 65535 photos in one project are not supported.");
   GatherStats stats;
   stats.raster_seen_vertices.assign(rasters.size(), 0);
+  // The diffuse form per vertex (make_sample reads the uniform one): one settings copy per form.
+  GatherSettings as_lambert = settings, as_coated = settings;
+  as_lambert.diffuse = DiffuseForms::everywhere(DiffuseForm::Lambert);
+  as_coated.diffuse = DiffuseForms::everywhere(DiffuseForm::Coated);
+  const auto settings_of_vertex = [&](size_t v) -> const GatherSettings & {
+    if (!settings.diffuse.varies()) return settings;
+    return settings.diffuse.at(v) == DiffuseForm::Coated ? as_coated : as_lambert;
+  };
   const size_t raster_count = std::max<size_t>(rasters.size(), 1);
   // A chunk holds a dense vertices x rasters block before compaction: size it to the budget.
   const size_t chunk_vertices = std::max<size_t>(
@@ -246,7 +254,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
           continue;
         }
         make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo, true,
-                    masks.is_lit(r, v), settings, out, masks.own_texels(r, v));
+                    masks.is_lit(r, v), settings_of_vertex(v), out, masks.own_texels(r, v));
       }
     }
     // Compact: keep samples seen by the camera, in vertex order.

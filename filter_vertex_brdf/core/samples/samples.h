@@ -94,9 +94,9 @@ struct GatherSettings {
   // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
   // (pipeline.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
   LobeForm lobe = LobeForm::PhongRE;
-  // The diffuse term's form stored in Sample::d (diffuse_form.h); the fit's PhongFitOptions::diffuse
-  // (pipeline.cpp keeps them equal). kGrazing stays N.L < T_d on the plain cosine.
-  DiffuseForm diffuse = DiffuseForm::Lambert;
+  // The diffuse term's form stored in Sample::d (diffuse_form.h), per vertex where it varies
+  // (gather_samples; make_sample takes `uniform`). kGrazing stays N.L < T_d on the plain cosine.
+  DiffuseForms diffuse;
   // Weight samples by their photo's resolution of the vertex (Sample::resolution); false: every
   // code 0 (all photos alike). Off by default: on the spot pair the two-camera fit scored worse
   // with it (README "The lobe's form and several cameras").
