@@ -6,8 +6,8 @@
 //
 // Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
 //   f = rho d + k_s max(s, 0)^alpha,  rho = k_d C,  unit irradiance
-//   d: the diffuse factor, N.L (Lambert) or N.L T(N.L) T(max(N.E, 0.2)) / T(1)^2 (coated), chosen
-//      per vertex (DiffuseForms: 1 coated, 0 Lambert) and mixed linearly where a triangle has both;
+//   d: the diffuse factor, N.L (Lambert) or N.L T(N.L) T(max(N.E, 0.2)) / T(1)^2 (coated), per
+//      vertex (`coated` 1 or 0, DiffuseForms; blended linearly across a triangle that has both);
 //   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
 //   N.L <= 0: attached shadow, black (the callers test it before calling phong_terms).
 // Vertices with k_s = 0 carry the median shininess of the fitted lobes (chosen on the CPU), so
@@ -35,10 +35,9 @@ float coat_transmission(float c) {
   return 1.0 - 0.5 * (rs * rs + rp * rp);
 }
 
-// samples/diffuse_form.h diffuse_factor; `coated` is the vertices' form interpolated over the
-// triangle (1 coated, 0 Lambert).
+// samples/diffuse_form.h diffuse_factor; `coated` in [0, 1] (interpolated vertex flag).
 float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
-  if (coated <= 0.0 || !(n_dot_l > 0.0)) return n_dot_l;
+  if (!(coated > 0.0) || !(n_dot_l > 0.0)) return n_dot_l;
   float t1 = coat_transmission(1.0);
   float coat = n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
   return mix(n_dot_l, coat, min(coated, 1.0));

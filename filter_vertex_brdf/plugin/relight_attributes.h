@@ -19,7 +19,7 @@ struct RelightModel {
   MeshArrays arrays;
   std::vector<vbrdf::VertexFit> fits;  // one per array vertex
   vbrdf::LobeForm lobe = vbrdf::LobeForm::PhongRE;
-  vbrdf::DiffuseForms diffuse;       // per vertex where the fit's coat map varies
+  vbrdf::DiffuseForms diffuse;  // per vertex where the fit made a coat map
   size_t modelled = 0;                 // vertices with fit_status != 0
 };
 

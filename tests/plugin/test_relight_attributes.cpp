@@ -60,7 +60,8 @@ TEST(RelightAttributes, ReadsTheStoredFit) {
   ASSERT_EQ(model.fits.size(), size_t(mesh->cm.vn));
   EXPECT_EQ(model.modelled, model.fits.size());
   EXPECT_EQ(model.lobe, vbrdf::LobeForm::BlinnNH);
-  EXPECT_EQ(model.diffuse.at(0), vbrdf::DiffuseForm::Coated);
+  EXPECT_FALSE(model.diffuse.varies());
+  EXPECT_EQ(model.diffuse.uniform, vbrdf::DiffuseForm::Coated);
   for (size_t v = 0; v < model.fits.size(); ++v) {
     EXPECT_FLOAT_EQ(model.fits[v].kd, 0.5f + 0.001f * float(v % 100));
     EXPECT_FLOAT_EQ(model.fits[v].color[1], 0.5f);

@@ -23,9 +23,8 @@ const char *const kLiveVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
-layout(location = 3) in vec2 a_ks_alpha;
+layout(location = 3) in vec3 a_ks_alpha_coated;
 layout(location = 4) in vec3 a_status_dq_sq;
-layout(location = 5) in float a_coated;
 uniform mat4 u_modelview;
 uniform mat4 u_projection;
 uniform int u_display;
@@ -35,8 +34,8 @@ out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_rho_fitted;
 out vec2 v_ks_alpha;
-out vec3 v_false_color;
 out float v_coated;
+out vec3 v_false_color;
 vec3 quality_color(float q) {  // live_legend.cpp quality_color
   float t = clamp(q, 0.0, 2.0);
   return t >= 1.0 ? mix(u_quality_stops[1], u_quality_stops[2], t - 1.0) : mix(u_quality_stops[0], u_quality_stops[1], t);
@@ -45,8 +44,8 @@ void main() {
   v_position = a_position;
   v_normal = a_normal;
   v_rho_fitted = a_rho_fitted;
-  v_ks_alpha = a_ks_alpha;
-  v_coated = a_coated;
+  v_ks_alpha = a_ks_alpha_coated.xy;
+  v_coated = a_ks_alpha_coated.z;
   if (u_display == 3) v_false_color = u_status_colors[int(clamp(a_status_dq_sq.x, 0.0, 4.0) + 0.5)];
   else if (u_display == 4) v_false_color = quality_color(a_status_dq_sq.y);
   else v_false_color = quality_color(a_status_dq_sq.z);
@@ -59,8 +58,8 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec4 v_rho_fitted;
 in vec2 v_ks_alpha;
-in vec3 v_false_color;
 in float v_coated;
+in vec3 v_false_color;
 uniform vec3 u_light_dir;
 uniform vec3 u_eye;
 uniform int u_eye_is_point;
@@ -101,7 +100,8 @@ void main() {
 }
 )";
 
-constexpr int kFloatsPerVertex = 16;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, status/dq/sq 3, coated 1
+constexpr int kFloatsPerVertex = 16;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, coated 1,
+                                      // status/dq/sq 3
 
 // Inverse of the upper-left 3x3 of a column-major 4x4; false when singular.
 bool invert_linear_part(const double m[16], double inv[9]) {
@@ -153,11 +153,12 @@ public:
   size_t vertex_count = 0;
 
 private:
-  void upload(const MeshView &mesh, const std::vector<VertexFit> &fits, const DiffuseForms &diffuse);
+  void upload(const MeshView &mesh, const std::vector<VertexFit> &fits);
   void release();
 
   GlApi gl_;
   LobeForm lobe_;
+  DiffuseForms diffuse_;
   size_t index_count_ = 0;
   double origin_[3] = {0, 0, 0};
   GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
@@ -166,7 +167,7 @@ private:
 
 LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc,
                         LobeForm lobe, const DiffuseForms &diffuse)
-    : gl_(load_gl_api(get_proc)), lobe_(lobe) {
+    : gl_(load_gl_api(get_proc)), lobe_(lobe), diffuse_(diffuse) {
   if (fits.size() != mesh.vertex_count)
     throw InputError("Live relighting: " + std::to_string(fits.size()) + " per-vertex fits for a mesh of " +
                      std::to_string(mesh.vertex_count) + " vertices: use the fit of this mesh.");
@@ -178,7 +179,7 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   try {
     program_ = build_program(gl_, kLiveVertexShader, phong_program_source(kLiveFragmentMain).c_str(),
                              "the live relighting pass");
-    upload(mesh, fits, diffuse);
+    upload(mesh, fits);
     check_gl_error(gl_, "the upload of the mesh for live relighting");
   } catch (...) {
     release();
@@ -186,7 +187,7 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   }
 }
 
-void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits, const DiffuseForms &diffuse) {
+void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
   const float alpha_default = typical_shininess(fits);
   std::vector<float> data(mesh.vertex_count * kFloatsPerVertex);
   for (size_t v = 0; v < mesh.vertex_count; ++v) {
@@ -200,10 +201,10 @@ void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit
     o[9] = f.status == kFitNone ? 0.0f : 1.0f;
     o[10] = f.ks;
     o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
-    o[12] = float(f.status);
-    o[13] = std::isfinite(f.dq) ? f.dq : 0.0f;
-    o[14] = std::isfinite(f.sq) ? f.sq : 0.0f;
-    o[15] = diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
+    o[12] = diffuse_.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
+    o[13] = float(f.status);
+    o[14] = std::isfinite(f.dq) ? f.dq : 0.0f;
+    o[15] = std::isfinite(f.sq) ? f.sq : 0.0f;
   }
   index_count_ = mesh.index_count;
   gl_.GenVertexArrays(1, &vao_);
@@ -212,8 +213,8 @@ void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[6] = {3, 3, 4, 2, 3, 1}, offsets[6] = {0, 3, 6, 10, 12, 15};
-  for (GLuint a = 0; a < 6; ++a) {
+  const int sizes[5] = {3, 3, 4, 3, 3}, offsets[5] = {0, 3, 6, 10, 13};
+  for (GLuint a = 0; a < 5; ++a) {
     gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
                             reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
     gl_.EnableVertexAttribArray(a);

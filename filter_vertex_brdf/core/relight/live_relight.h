@@ -50,9 +50,8 @@ bool eye_to_world_direction(const double modelview[16], const double eye_directi
 
 class LiveRelight {
 public:
-  // Uploads the mesh (positions relative to its bounding-box centre, for precision), one
-  // VertexFit per vertex (k_s = 0 vertices get the median shininess, phong_model_source.h) and
-  // each vertex's diffuse form.
+  // Uploads the mesh (positions relative to its bounding-box centre, for precision) and one
+  // VertexFit per vertex (k_s = 0 vertices get the median shininess, phong_model_source.h).
   // Requires a current GL >= 3.3 context for the object's lifetime. Throws InputError when the
   // counts differ or an index is out of range, ProcessingError when the context cannot compile
   // the shader.

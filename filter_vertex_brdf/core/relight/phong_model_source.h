@@ -19,8 +19,8 @@ struct GlApi;
 // ProcessingError when the library was built without the embedded shader.
 std::string phong_program_source(const char *body);
 
-// Sets phong_model.glsl's uniforms of `program` (which must be in use) for the fit's lobe form
-// (the diffuse form is per vertex: the caller's vertex attribute, 1 coated, 0 Lambert).
+// Sets phong_model.glsl's uniforms of `program` (which must be in use) for the fit's lobe form and
+// the coat's constants (the diffuse form is a per-vertex attribute of the callers).
 void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe);
 
 // The shininess given to k_s = 0 vertices: the median of the fitted lobes (k_s > 0, alpha > 0,
