@@ -1,8 +1,9 @@
 // Live relighting (live_relight.h), the render path of MeshLab's "Vertex BRDF: relight" plugin,
 // against the relight renderer (relight_render.h) for the same light and view: both evaluate
 // shaders/phong_model.glsl, so on every lit interior pixel of a convex object (no cast shadows,
-// the one stated difference) they must agree within kTolerance. A control with the other lobe form
-// shows that the comparison can fail. GL through OSMesa; skipped when no context can be created.
+// the one stated difference) they must agree within kTolerance. Controls with the other lobe form
+// and with every vertex's diffuse form swapped show that the comparison can fail. GL through
+// OSMesa; skipped when no context can be created.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -149,9 +150,16 @@ void check_forms(LobeForm lobe, const DiffuseForms &diffuse) {
   LiveRelight wrong(s.mesh.view(), s.fits, ctx->get_proc_address(), other, diffuse);
   const Agreement control = compare(ref, wrong.render_offscreen(live_view(s, LiveDisplay::Full, 1.0f, false), kW, kH), 1.0f, false);
   EXPECT_GT(control.worst, 0.0) << "the comparison does not see a different lobe form";
+  // Control: every vertex's diffuse form swapped (coated <-> Lambert) must fail it too.
+  auto flipped = std::make_shared<std::vector<uint8_t>>(s.fits.size());
+  for (size_t v = 0; v < s.fits.size(); ++v) (*flipped)[v] = diffuse.at(v) == DiffuseForm::Coated ? 0 : 1;
+  LiveRelight swapped(s.mesh.view(), s.fits, ctx->get_proc_address(), lobe, DiffuseForms{DiffuseForm::Lambert, flipped});
+  const Agreement control_d =
+      compare(ref, swapped.render_offscreen(live_view(s, LiveDisplay::Full, 1.0f, false), kW, kH), 1.0f, false);
+  EXPECT_GT(control_d.worst, 0.0) << "the comparison does not see the vertices' diffuse forms";
   std::cout << lobe_form_label(lobe) << "/" << describe_diffuse_forms(diffuse) << ": " << linear.compared
             << " pixels, largest difference " << linear.max_abs << " linear, " << screen.max_abs
-            << " sRGB; other lobe form: " << control.max_abs << "\n";
+            << " sRGB; other lobe form: " << control.max_abs << ", diffuse forms swapped: " << control_d.max_abs << "\n";
 }
 
 TEST(LiveRelight, MatchesRelightRendererPhongLambert) {
