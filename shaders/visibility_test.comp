@@ -9,7 +9,9 @@
 // GL back end keeps for contexts without compute shaders; unit tests hold both paths against the
 // CPU ray caster. Camera pass: window coordinates come from the undistorted projection the depth
 // pass was rasterised with; a vertex outside that image or behind the camera is kCameraClear (the
-// frustum is not this pass's concern: samples.cpp tests it with the distorted projection).
+// frustum is not this pass's concern: samples.cpp tests it with the distorted projection). The
+// camera map may have one texel per u_divisor x u_divisor photo pixels (visibility/pass_size.h):
+// window coordinates are map texels, footprints stay in photo pixels.
 layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Positions { float positions[]; };  // x y z per vertex, origin-relative
@@ -26,6 +28,8 @@ uniform float u_slack_per_depth; // camera pass: own_surface_depth_slack = toler
 uniform float u_light_scale;     // light pass: window mapping of light_view.h
 uniform int u_perspective;       // light pass: 1 for a point light (w = depth)
 uniform sampler2D u_depth;       // R32F linear depth, GL rows (row 0 = bottom of the image)
+uniform int u_divisor;           // camera pass: photo pixels per map texel, per axis
+uniform int u_photo_width, u_photo_height;  // camera pass: photo size in pixels
 
 ivec2 map_size() { return ivec2(u_width, u_height); }
 
@@ -40,16 +44,31 @@ bool depth_clear(vec2 w, float depth) {
   return depth <= far_depth + u_tolerance;
 }
 
-// The 2x2 bilinear footprint of image point img (pixels, y down): which texels show the vertex's
-// own surface.
+bool own(int x, int y, float depth, float allowed) { return abs(texel(x, y) - depth) <= allowed; }
+
+// The 2x2 bilinear footprint of photo point img (photo pixels, y down): which texels show the
+// vertex's own surface. With u_divisor > 1 a photo texel is own surface only when the four map
+// texels around its centre all are (conservative: visibility_gl.cpp's footprint_code).
 uint footprint_code(vec2 img, float depth) {
   float allowed = u_tolerance + u_slack_per_depth * depth;
   int x0 = int(floor(img.x - 0.5)), y0 = int(floor(img.y - 0.5));
+  ivec2 last = map_size() - 1;
   uint mask = 0u;
   for (int k = 0; k < 4; ++k) {
-    int i = x0 + k % 2, row = map_size().y - 1 - (y0 + k / 2);
-    if (i < 0 || row < 0 || i >= map_size().x || row >= map_size().y) continue;
-    if (abs(texel(i, row) - depth) <= allowed) mask |= 1u << uint(k);
+    int px = x0 + k % 2, py = y0 + k / 2;
+    if (px < 0 || py < 0 || px >= u_photo_width || py >= u_photo_height) continue;
+    bool is_own;
+    if (u_divisor <= 1) {
+      is_own = own(px, u_photo_height - 1 - py, depth, allowed);
+    } else {
+      vec2 w = (vec2(float(px) + 0.5, float(u_photo_height - py) - 0.5)) / float(u_divisor);
+      int i0 = int(floor(w.x - 0.5)), j0 = int(floor(w.y - 0.5));
+      int xa = clamp(i0, 0, last.x), xb = clamp(i0 + 1, 0, last.x);
+      int ya = clamp(j0, 0, last.y), yb = clamp(j0 + 1, 0, last.y);
+      is_own = own(xa, ya, depth, allowed) && own(xb, ya, depth, allowed) && own(xa, yb, depth, allowed) &&
+               own(xb, yb, depth, allowed);
+    }
+    if (is_own) mask |= 1u << uint(k);
   }
   return mask == 15u ? 1u : (16u | mask);
 }
@@ -59,9 +78,9 @@ uint camera_code(vec3 p) {
   float depth = -view_pos.z;
   vec4 clip = u_projection * view_pos;
   if (!(clip.w > 0.0) || !(depth > 0.0)) return 1u;
-  vec2 w = (clip.xy / clip.w * 0.5 + 0.5) * vec2(map_size());
-  vec2 img = vec2(w.x, float(map_size().y) - w.y);
-  if (!(img.x >= 0.0 && img.x < float(map_size().x) && img.y >= 0.0 && img.y < float(map_size().y))) return 1u;
+  vec2 w = (clip.xy / clip.w * 0.5 + 0.5) * vec2(map_size());  // map texels
+  vec2 img = vec2(w.x * float(u_divisor), float(u_photo_height) - w.y * float(u_divisor));  // photo pixels
+  if (!(img.x >= 0.0 && img.x < float(u_photo_width) && img.y >= 0.0 && img.y < float(u_photo_height))) return 1u;
   if (!depth_clear(w, depth)) return 0u;
   return footprint_code(img, depth);
 }

@@ -3,12 +3,14 @@
 // first P photos. Prints one CSV line per run:
 //   backend,vertices,photos,width,height,visibility_s,gather_s,total_s,samples
 //   bench_gather project.mlp [--backend gl|gl-readback|cpu|both|all] [--photos 4,8,16,32] [--csv-header] [--passes]
+//                [--shadow-map N] [--camera-divisor D]   (0 = automatic, the default: visibility/pass_size.h)
 // gl: depth tests in a compute shader (the fit's default); gl-readback: depth maps read back and tested
 // on the CPU; both = gl and cpu; all = the three.
 // --passes: instead, the time of one camera pass (the first raster's camera, photo size) and one
-// light pass (its light; shadow map at the automatic size the fit uses), measured on the second
-// call of each (render targets exist), after the back end's setup (upload / grid):
-//   passes,backend,vertices,width,height,shadow_map,setup_s,camera_pass_s,light_pass_s
+// light pass (its light; the sizes the fit uses unless set), measured on the second call of each
+// (render targets exist), after the back end's setup (upload / grid); camera_map is the camera
+// pass's map (WxH), shadow_map the light pass's side (0 for the CPU):
+//   passes,backend,vertices,width,height,camera_map,shadow_map,setup_s,camera_pass_s,light_pass_s
 // (The GL visibility unit tests check these passes for correctness only: timing a shared test
 // machine makes a flaky test, so the figures live here.)
 #include <chrono>
@@ -45,9 +47,11 @@ bool wanted(const std::string &asked, const std::string &backend) {
   return asked == backend || asked == "all" || (asked == "both" && backend != "gl-readback");
 }
 
+VisibilitySettings g_settings;  // automatic pass sizes, as the fit, unless set on the command line
+
 std::unique_ptr<VisibilityBackend> make_backend(const std::string &backend, const MeshData &mesh,
                                                 test::OsMesaContext &context) {
-  VisibilitySettings settings;  // automatic shadow-map size, as the fit
+  VisibilitySettings settings = g_settings;
   settings.depth_tests_on_gpu = backend != "gl-readback";
   return backend == "cpu" ? make_cpu_visibility(mesh.view(), settings)
                           : make_gl_visibility(mesh.view(), context.get_proc_address(), settings);
@@ -56,7 +60,6 @@ std::unique_ptr<VisibilityBackend> make_backend(const std::string &backend, cons
 // One camera and one light pass, timed on their second call (see the header).
 void time_passes(const std::string &backend, const MeshData &mesh, const Raster &raster, const LightSource &light,
                  test::OsMesaContext &context) {
-  const VisibilitySettings settings;
   const double t0 = now();
   auto vis = make_backend(backend, mesh, context);
   const double setup = now() - t0;
@@ -68,8 +71,9 @@ void time_passes(const std::string &backend, const MeshData &mesh, const Raster 
   const double t2 = now();
   vis->light_pass(light, out.data());
   const double t3 = now();
-  std::printf("passes,%s,%zu,%d,%d,%d,%.3f,%.3f,%.3f\n", backend.c_str(), mesh.positions.size() / 3, raster.width(),
-              raster.height(), resolved_shadow_map_size(mesh.view(), settings), setup, t2 - t1, t3 - t2);
+  const VisibilityBackend::PassSizes sizes = vis->last_pass_sizes();
+  std::printf("passes,%s,%zu,%d,%d,%dx%d,%d,%.3f,%.3f,%.3f\n", backend.c_str(), mesh.positions.size() / 3, raster.width(),
+              raster.height(), sizes.camera_width, sizes.camera_height, sizes.shadow_map, setup, t2 - t1, t3 - t2);
   std::fflush(stdout);
 }
 
@@ -78,7 +82,7 @@ void time_passes(const std::string &backend, const MeshData &mesh, const Raster 
 int main(int argc, char **argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: bench_gather project.mlp [--backend gl|gl-readback|cpu|both|all] [--photos 4,8,16,32] [--csv-header] "
-                         "[--passes]\n");
+                         "[--passes] [--shadow-map N] [--camera-divisor D]\n");
     return 2;
   }
   std::string backend = "both";
@@ -90,6 +94,8 @@ int main(int argc, char **argv) {
     else if (a == "--photos" && i + 1 < argc) photo_counts = parse_list(argv[++i]);
     else if (a == "--csv-header") header = true;
     else if (a == "--passes") passes = true;
+    else if (a == "--shadow-map" && i + 1 < argc) g_settings.shadow_map_size = std::stoi(argv[++i]);
+    else if (a == "--camera-divisor" && i + 1 < argc) g_settings.camera_pass_divisor = std::stoi(argv[++i]);
   }
   const Project project = read_project(argv[1]);
   const MeshData mesh = load_mesh_ply(project.mesh_path);
@@ -98,7 +104,7 @@ int main(int argc, char **argv) {
   if (photo_counts.empty()) photo_counts.push_back(int(project.rasters.size()));
   test::OsMesaContext context;
   if (passes) {
-    if (header) std::printf("passes,backend,vertices,width,height,shadow_map,setup_s,camera_pass_s,light_pass_s\n");
+    if (header) std::printf("passes,backend,vertices,width,height,camera_map,shadow_map,setup_s,camera_pass_s,light_pass_s\n");
     for (const std::string b : kBackends)
       if (wanted(backend, b)) time_passes(b, mesh, project.rasters.at(0), all_lights.at(0), context);
     return 0;

@@ -27,7 +27,7 @@ using namespace vbrdf;
 namespace {
 int usage() {
   std::cerr << "usage: vbrdf_fit project.mlp [--lp F] [--dome-radius R] [--light-unit-scale S] [--out F.ply] [--visibility auto|gl|cpu] [--ts X] [--td X]\n"
-               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--depth-tests gpu|cpu] [--fit auto|gpu|cpu|off]\n"
+               "                 [--encoding auto|srgb|linear] [--shadow-map N] [--camera-divisor D] [--depth-tests gpu|cpu] [--fit auto|gpu|cpu|off]\n"
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
@@ -50,6 +50,7 @@ int main(int argc, char **argv) {
     else if (a == "--ts") settings.gather.specular_threshold = std::stof(next());
     else if (a == "--td") settings.gather.diffuse_threshold = std::stof(next());
     else if (a == "--shadow-map") settings.visibility.shadow_map_size = std::stoi(next());
+    else if (a == "--camera-divisor") settings.visibility.camera_pass_divisor = std::stoi(next());
     else if (a == "--depth-tests") settings.visibility.depth_tests_on_gpu = next() != "cpu";  // gpu (default) | cpu
     else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
     else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());

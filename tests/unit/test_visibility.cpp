@@ -16,6 +16,7 @@
 #include "gl/gl_api.h"
 #include "base/mesh_view.h"
 #include "osmesa_context.h"
+#include "visibility/pass_size.h"
 #include "visibility/visibility.h"
 #include "visibility/visibility_gl.h"
 
@@ -469,13 +470,17 @@ std::vector<std::vector<uint8_t>> perturbed_light_runs(VisibilityBackend &cpu, c
   return runs;
 }
 
+// `pixels`: how far (photo pixels) a silhouette may move and still explain a disagreement: 2 for
+// a pass at photo resolution; a camera pass at 1/d of it (pass_size.h) moves silhouettes by up to
+// a map texel more (the caller passes 2 d).
 Comparison compare_camera(VisibilityBackend &gl, VisibilityBackend &cpu, const MeshData &m, const Shot &shot,
-                          std::vector<uint8_t> *gl_out = nullptr) {
+                          std::vector<uint8_t> *gl_out = nullptr, double pixels = 2.0) {
   const auto g = run_camera(gl, m, shot), c = run_camera(cpu, m, shot);
   if (gl_out) *gl_out = g;
   const V3 centre = centre_of(shot);
-  const Footprint f = camera_footprint(m, shot);
-  return compare(m, g, c, perturbed_camera_runs(cpu, m, shot, 2.0), &f,
+  Footprint f = camera_footprint(m, shot);
+  for (size_t v = 0; v < f.x.size(); ++v) f.x[v] *= float(2.0 / pixels), f.y[v] *= float(2.0 / pixels);
+  return compare(m, g, c, perturbed_camera_runs(cpu, m, shot, pixels), &f,
                  [&](size_t v) { return centre - v3(&m.positions[3 * v]); });
 }
 
@@ -484,8 +489,9 @@ Comparison compare_light(VisibilityBackend &gl, VisibilityBackend &cpu, const Me
   const V3 l = normalized(dir);
   const auto g = run_light(gl, m, l), c = run_light(cpu, m, l);
   if (gl_out) *gl_out = g;
-  // 0.01 rad moves a shadow edge cast from 0.1 away by about one shadow-map texel.
-  const Footprint f = light_footprint(m, l, VisibilitySettings().shadow_map_size);
+  // 0.01 rad moves a shadow edge cast from 0.1 away by about one shadow-map texel; "nearby" is
+  // within 2 texels of the map this pass used (its size varies with the light: pass_size.h).
+  const Footprint f = light_footprint(m, l, gl.last_pass_sizes().shadow_map);
   return compare(m, g, c, perturbed_light_runs(cpu, m, l, 0.01), &f, [&](size_t) { return l; });
 }
 
@@ -1129,8 +1135,10 @@ TEST_F(GlVisibilityTest, ComputeShaderTestsGiveTheReadBackCodes) {
     return d;
   };
   const size_t limit = vertex_count(m) / 1000;
-  for (const Shot &shot : {dense_scene_camera(), dense_scene_camera(321, 237)}) {
+  // The last shot's pass is divided (a map texel of 2 x 2 photo pixels, pass_size.h).
+  for (const Shot &shot : {dense_scene_camera(), dense_scene_camera(321, 237), dense_scene_camera(1800, 1350)}) {
     const auto a = run_camera(*gpu, m, shot), b = run_camera(*readback, m, shot);
+    EXPECT_EQ(gpu->last_pass_sizes().camera_divisor, readback->last_pass_sizes().camera_divisor);
     std::printf("  camera %dx%d: %zu of %u vertices differ; %ld hidden, %ld partial footprints\n",
                 shot.Intrinsics.ViewportPx[0], shot.Intrinsics.ViewportPx[1], differing(a, b), vertex_count(m),
                 long(std::count(a.begin(), a.end(), kCameraHidden)),
@@ -1138,6 +1146,7 @@ TEST_F(GlVisibilityTest, ComputeShaderTestsGiveTheReadBackCodes) {
     EXPECT_LE(differing(a, b), limit);
     EXPECT_GT(std::count(a.begin(), a.end(), kCameraHidden), long(vertex_count(m) / 50));  // the test has teeth
   }
+  EXPECT_EQ(gpu->last_pass_sizes().camera_divisor, 2);
   for (V3 light : kLights) {
     const auto a = run_light(*gpu, m, normalized(light)), b = run_light(*readback, m, normalized(light));
     EXPECT_LE(differing(a, b), limit) << light_label("dense", normalized(light));
@@ -1182,5 +1191,86 @@ TEST_F(GlVisibilityTest, ComputeShaderTestsRestoreTheHostsBindings) {
   api.DeleteTextures(1, &host_texture);
   api.DeleteBuffers(2, host_buffers);
 }
+
+// Camera passes smaller than the photo (pass_size.h): a 26 800-vertex scene photographed at 1800
+// and 3600 pixels wide, where the mesh's edges span ~6.8 and ~13.6 pixels, so the automatic pass
+// is rendered at 1/2 and 1/4 of the photo's resolution. Against the CPU ray caster (exact rays, the
+// footprint texels cast at photo resolution):
+//  - occlusion: the bound of photo-resolution passes (<= 2 % of the front-facing vertices
+//    disagree, nearly all within a map texel of an occluder's silhouette);
+//  - footprints stay conservative: a footprint texel the divided pass calls the vertex's own
+//    surface is own surface for the CPU too (<= 0.3 % of the clear vertices claim one it does
+//    not, as many as at photo resolution + 0.2 %): no clean sample takes a colour from across a
+//    depth jump. The price: a band of up to d pixels along silhouettes, and steep faces, read as
+//    partial footprints (at most (d + 1) times those of the photo-resolution pass).
+TEST_F(GlVisibilityTest, DividedCameraPassesAgreeWithTheCpu) {
+  const MeshData m = dense_scene(160, 24);
+  auto cpu = make_cpu_visibility(m.view(), VisibilitySettings());
+  VisibilitySettings photo_resolution;
+  photo_resolution.camera_pass_divisor = 1;
+  auto sized = gl(m), full = gl(m, photo_resolution);
+  const auto own_of = [](uint8_t code) { return code == kCameraClear ? kAllFootprintTexels : uint8_t(code & 0xF); };
+  const auto partial = [](const std::vector<uint8_t> &codes) {
+    return size_t(std::count_if(codes.begin(), codes.end(), [](uint8_t c) { return (c & kFootprintPartial) != 0; }));
+  };
+  for (int width : {1800, 3600}) {
+    const Shot shot = dense_scene_camera(width, width * 3 / 4);
+    std::vector<uint8_t> a;
+    char label[64];
+    std::snprintf(label, sizeof label, "dense camera %dx%d, sized", width, width * 3 / 4);
+    const int d_expected = width == 1800 ? 2 : 4;
+    const Comparison cmp = compare_camera(*sized, *cpu, m, shot, &a, 2.0 * d_expected);
+    const int d = sized->last_pass_sizes().camera_divisor;
+    EXPECT_EQ(d, d_expected) << "the scene must exercise a divided pass";
+    EXPECT_EQ(sized->last_pass_sizes().camera_width, (width + d - 1) / d);
+    expect_agreement(label, cmp);
+    const auto c = run_camera(*cpu, m, shot), f = run_camera(*full, m, shot);
+    EXPECT_EQ(full->last_pass_sizes().camera_divisor, 1);
+    size_t clear = 0, extra_sized = 0, extra_full = 0;
+    for (size_t v = 0; v < c.size(); ++v) {
+      if (c[v] == kCameraHidden) continue;
+      ++clear;
+      if (a[v] != kCameraHidden && (own_of(a[v]) & ~own_of(c[v]))) ++extra_sized;
+      if (f[v] != kCameraHidden && (own_of(f[v]) & ~own_of(c[v]))) ++extra_full;
+    }
+    std::printf("  %s: divisor %d; own texels the CPU does not see: %zu sized, %zu at photo resolution, of %zu "
+                "clear; partial footprints %zu sized, %zu at photo resolution, %zu CPU\n",
+                label, d, extra_sized, extra_full, clear, partial(a), partial(f), partial(c));
+    EXPECT_LE(extra_sized, clear * 3 / 1000);
+    EXPECT_LE(extra_sized, extra_full + clear / 500);
+    EXPECT_GE(partial(a), partial(f) * 9 / 10);  // conservative: no fewer partial footprints
+    EXPECT_LE(partial(a), partial(f) * size_t(d + 1) + 10);
+    EXPECT_GT(partial(c), size_t(100));  // the scene has silhouettes
+  }
+}
+
+// Shadow maps sized per light (pass_size.h) against the former fixed size (resolved_shadow_map_size:
+// 2048 here, where the overhead light's map is ~1400) and the CPU: the sized pass meets the bound
+// of the others (<= 2 % of the vertices facing the light disagree with the CPU, nearly all within
+// 2 map texels of a shadow edge) and disagrees with the CPU on at most 25 % (+ 10) more
+// front-facing vertices than the former size, for three directional lights and a point light.
+TEST_F(GlVisibilityTest, SizedShadowMapsAgreeWithTheCpu) {
+  const MeshData m = dense_scene(230, 24);
+  auto cpu = make_cpu_visibility(m.view(), VisibilitySettings());
+  VisibilitySettings fixed;
+  fixed.shadow_map_size = resolved_shadow_map_size(m.view(), VisibilitySettings());
+  auto sized = gl(m), former = gl(m, fixed);
+  for (V3 light : kLights) {
+    const Comparison s = compare_light(*sized, *cpu, m, light), f = compare_light(*former, *cpu, m, light);
+    const int size = sized->last_pass_sizes().shadow_map;
+    std::printf("  %s: map %d (former %d): %zu front-facing disagreements (former %zu)\n",
+                light_label("dense", normalized(light)).c_str(), size, fixed.shadow_map_size, s.front_total, f.front_total);
+    EXPECT_LE(size, fixed.shadow_map_size);
+    if (light.z == 1) EXPECT_LT(size, fixed.shadow_map_size);  // the test compares two different sizes
+    EXPECT_GE(size, kMinShadowMapSize);
+    expect_agreement(light_label("dense sized", normalized(light)), s);
+    EXPECT_LE(s.front_total, f.front_total * 5 / 4 + 10);
+  }
+  const auto p = run_point_light(*sized, m, {0.2, -0.3, 2.2}), q = run_point_light(*cpu, m, {0.2, -0.3, 2.2});
+  size_t diff = 0;
+  for (size_t v = 0; v < p.size(); ++v) diff += p[v] != q[v];
+  EXPECT_LE(diff, p.size() / 50);
+}
+
 } // namespace
 } // namespace vbrdf

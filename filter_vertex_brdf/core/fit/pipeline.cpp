@@ -18,6 +18,7 @@
 #include "io/fit_outputs.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
+#include "visibility/pass_size.h"
 
 namespace vbrdf {
 
@@ -218,6 +219,12 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   auto t = Clock::now();
   const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
   VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
+  {
+    const std::string sizes = describe_pass_sizes(visibility.last_pass_sizes());
+    result.depth_passes = std::to_string(masks.camera_passes) + " camera pass(es) for " +
+                          std::to_string(input.rasters.size()) + " photos (photos of one camera share its pass)" +
+                          (sizes.empty() ? std::string() : "; " + sizes);
+  }
   restrict_to_vertices(masks, input.vertex_mask);
   result.seconds_visibility = seconds_since(t);
   prefetch->finish();

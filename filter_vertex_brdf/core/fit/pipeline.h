@@ -109,6 +109,7 @@ struct FitResult {
   std::vector<VertexAttribute> attributes;// what goes into the PLY
   GatherStats gather;
   std::string visibility_backend;         // name of the back end that ran
+  std::string depth_passes;               // camera passes run, sizes of the depth maps (pass_size.h)
   std::string fit_backend;                // name of the fit back end ("" when not fitted)
   size_t fit_full = 0, fit_diffuse_only = 0, fit_none = 0, fit_converged = 0, fit_iterations = 0;
   size_t fit_weak = 0, fit_neighbours = 0;  // fit_status 4 and 3

@@ -143,6 +143,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << "lights against the photos (predicted irradiance vs brightness): "
       << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
       << "visibility back end: " << r.visibility_backend << "\n"
+      << (r.depth_passes.empty() ? std::string() : "depth passes: " + r.depth_passes + "\n")
       << color_report(r, settings)
       << "thresholds: T_s (R.E) = " << settings.gather.specular_threshold
       << ", T_d (N.L) = " << settings.gather.diffuse_threshold << "\n"

@@ -113,16 +113,23 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
   if (mesh.vertex_count >= (size_t(1) << 28))
     throw InputError("Meshes of more than 268 million vertices are not supported.");
   for (auto *v : {&masks.off_image, &masks.back_facing, &masks.occluded, &masks.seen_count}) v->assign(rasters.size(), 0);
-  std::vector<uint8_t> buffer(mesh.vertex_count);
+  // The camera pass depends on the shot only: photos from the camera of the previous pass (an RTI
+  // capture: one camera, many lights) reuse its codes (same_shot: equal to 1e-6 relative).
+  std::vector<uint8_t> camera(mesh.vertex_count), buffer(mesh.vertex_count);
+  const Shot *camera_shot = nullptr;
   for (size_t r = 0; r < rasters.size(); ++r) {
     report(progress, float(r) / float(rasters.size()), "visibility");
-    std::fill(buffer.begin(), buffer.end(), 0);
-    backend.camera_pass(rasters[r].shot, buffer.data());
+    if (!camera_shot || !same_shot(*camera_shot, rasters[r].shot)) {
+      std::fill(camera.begin(), camera.end(), 0);
+      backend.camera_pass(rasters[r].shot, camera.data());
+      camera_shot = &rasters[r].shot;
+      ++masks.camera_passes;
+    }
     uint32_t counts[4];
-    classify_seen(mesh, rasters[r], buffer, &masks.seen[r * masks.words()], &masks.mixed[r * masks.words()], counts);
+    classify_seen(mesh, rasters[r], camera, &masks.seen[r * masks.words()], &masks.mixed[r * masks.words()], counts);
     masks.off_image[r] = counts[0], masks.back_facing[r] = counts[1], masks.occluded[r] = counts[2];
     masks.seen_count[r] = counts[3];
-    masks.footprints[r] = footprint_list(buffer, &masks.mixed[r * masks.words()], masks.words());
+    masks.footprints[r] = footprint_list(camera, &masks.mixed[r * masks.words()], masks.words());
     if (counts[3] == 0) continue;  // a photo that sees nothing needs no shadow pass
     std::fill(buffer.begin(), buffer.end(), 0);
     backend.light_pass(lights[r], buffer.data());

@@ -116,6 +116,7 @@ struct VisibilityMasks {
   // vertex's own surface (visibility.h). Sparse: only rims and contacts are listed.
   std::vector<std::vector<uint32_t>> footprints;
   std::vector<uint32_t> off_image, back_facing, occluded, seen_count;  // per raster
+  size_t camera_passes = 0;  // camera passes run: one per run of rasters with the same shot
   size_t words() const { return (vertex_count + 63) / 64; }
   bool is_seen(size_t r, size_t v) const { return (seen[r * words() + v / 64] >> (v % 64)) & 1u; }
   bool is_lit(size_t r, size_t v) const { return (lit[r * words() + v / 64] >> (v % 64)) & 1u; }
@@ -128,6 +129,7 @@ struct VisibilityMasks {
 
 
 // Runs the camera and light depth passes for every raster. lights[r] is the light of raster r.
+// A raster whose shot is the previous camera pass's (same_shot) reuses that pass's codes.
 VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
                                    const std::vector<LightSource> &lights,
                                    VisibilityBackend &backend, const ProgressFn &progress = {});

@@ -17,19 +17,26 @@ struct VisibilitySettings {
   // Depth tolerance as a fraction of the mesh bounding-box diagonal: a vertex counts as visible
   // when it is at most this much behind the first surface along the ray.
   float depth_tolerance = 0.002f;
-  // Resolution (square) of the light-view orthographic depth map over the mesh bounds.
-  // 0 = automatic (resolved_shadow_map_size).
+  // Resolution (square) of the light-view depth map over the mesh bounds. 0 = automatic: per
+  // light, from the mesh's edges as the light sees them, at most resolved_shadow_map_size
+  // (pass_size.h: light_pass_size).
   int shadow_map_size = 0;
+  // GL camera pass: rendered at 1/d of the photo's resolution per axis. 0 = automatic (from the
+  // mesh's edges as the camera sees them, pass_size.h: camera_pass_divisor); 1 = the photo's
+  // resolution.
+  int camera_pass_divisor = 0;
   // GL back end: test the vertices against each depth map in a compute shader, where the map
   // stays, and read back one byte per vertex (needs OpenGL 4.3). false, or a context without
   // compute shaders: read the map back and test on the CPU. Both give the same codes.
   bool depth_tests_on_gpu = true;
 };
 
-// The shadow-map resolution to use: `settings.shadow_map_size` when positive; for 0, the power of
+// The largest shadow map of a mesh: `settings.shadow_map_size` when positive; for 0, the power of
 // two that makes a texel at most a quarter of the median edge length over the mesh's bounding
 // sphere, clamped to [1024, 4096] (a shadow edge is then placed to within a fraction of a vertex
-// spacing; finer maps cost time, quadratically, and change few vertices' flags). Throws InputError when negative.
+// spacing; finer maps cost time, quadratically, and change few vertices' flags). Throws InputError
+// when negative. The relighting renderer uses it; the visibility light pass sizes each light's map
+// below it (pass_size.h).
 int resolved_shadow_map_size(const MeshView &mesh, const VisibilitySettings &settings);
 
 // Camera-pass output codes (VisibilityBackend::camera_pass).
@@ -76,6 +83,13 @@ public:
   // rays along it); a point light from `light.position` (a perspective shadow map from there,
   // fitted to the mesh's bounding sphere; CPU: rays towards the position, stopping there).
   virtual void light_pass(const LightSource &light, uint8_t *out) = 0;
+  // The depth maps of the passes (GL back end; zeros elsewhere): the last camera pass's map size and
+  // divisor (pass_size.h), the last light pass's side, and their ranges over all passes so far.
+  struct PassSizes {
+    int camera_width = 0, camera_height = 0, camera_divisor = 0, shadow_map = 0;
+    int divisor_min = 0, divisor_max = 0, shadow_min = 0, shadow_max = 0;
+  };
+  virtual PassSizes last_pass_sizes() const { return PassSizes(); }
 };
 
 // CPU reference: rays from each vertex (offset along the ray by the tolerance) against a
