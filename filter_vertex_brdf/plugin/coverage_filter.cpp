@@ -6,6 +6,7 @@
 
 #include "core/base/errors.h"
 #include "filter_parameters.h"
+#include "host_photos.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
@@ -156,6 +157,7 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
   input.mesh_name = mesh->label().toUtf8().toStdString();
   const ActiveRasters active = active_rasters(run.document);
   input.rasters = active.rasters;
+  settings.gather.host_photos = host_photos(run.document);  // read in place, not decoded again
   shared::log_hidden_rasters(active.hidden, active.rasters.size(), log);
   if (display.only_selected) input.vertex_mask = shared::selection_mask(*mesh, arrays, log);
   input.project_path = project_path(run.document, *mesh);

@@ -6,6 +6,7 @@
 
 #include "core/base/errors.h"
 #include "filter_parameters.h"
+#include "host_photos.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
@@ -175,6 +176,7 @@ void FitFilter::apply(FilterRun &run) const {
   input.mesh_colors = arrays.data.colors;
   const ActiveRasters active = active_rasters(run.document);
   input.rasters = active.rasters;
+  settings.gather.host_photos = host_photos(run.document);  // read in place, not decoded again
   shared::log_hidden_rasters(active.hidden, active.rasters.size(), log);
   if (shared::only_selected(run.params)) input.vertex_mask = shared::selection_mask(*mesh, arrays, log);
   input.project_path = project_path(run.document, *mesh);

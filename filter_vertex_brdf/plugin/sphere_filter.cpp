@@ -54,10 +54,9 @@ template <typename T>
 cv::Mat gray_of(const vbrdf::Photo &photo) {
   cv::Mat out(photo.pixels.size(), CV_32FC1);
   for (int y = 0; y < out.rows; ++y) {
-    const T *in = photo.pixels.ptr<T>(y);
     float *o = out.ptr<float>(y);
     for (int x = 0; x < out.cols; ++x)
-      o[x] = (photo.lut[in[3 * x]] + photo.lut[in[3 * x + 1]] + photo.lut[in[3 * x + 2]]) / 3.0f;
+      o[x] = (photo.lut[photo.code<T>(x, y, 0)] + photo.lut[photo.code<T>(x, y, 1)] + photo.lut[photo.code<T>(x, y, 2)]) / 3.0f;
   }
   return out;
 }

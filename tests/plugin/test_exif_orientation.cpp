@@ -69,10 +69,10 @@ TEST(ExifOrientation, FitReadsThePixelsMeshLabShows) {
   for (int y = 0; y < 32; y += 5)
     for (int x = 0; x < 64; x += 7) {
       const QRgb q = shown.pixel(x, y);
-      const cv::Vec3b p = photo.pixels.at<cv::Vec3b>(y, x);  // RGB order
+      const cv::Vec3b p(photo.code<uint8_t>(x, y, 0), photo.code<uint8_t>(x, y, 1), photo.code<uint8_t>(x, y, 2));  // RGB
       EXPECT_NEAR(int(p[0]), qRed(q), 2) << x << "," << y;
       EXPECT_NEAR(int(p[2]), qBlue(q), 2) << x << "," << y;
     }
-  EXPECT_LT(int(photo.pixels.at<cv::Vec3b>(16, 4)[0]), 60);    // left stays dark
-  EXPECT_GT(int(photo.pixels.at<cv::Vec3b>(16, 60)[0]), 200);  // right stays bright
+  EXPECT_LT(int(photo.code<uint8_t>(4, 16, 0)), 60);    // left stays dark
+  EXPECT_GT(int(photo.code<uint8_t>(60, 16, 0)), 200);  // right stays bright
 }

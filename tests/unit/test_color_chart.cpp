@@ -8,6 +8,8 @@
 #include <cmath>
 #include <random>
 
+#include <limits>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -186,6 +188,34 @@ TEST(ChartCorrection, TooFewUsablePatchesIsAnError) {
   EXPECT_THROW(fit_color_correction(ref, ref, usable), ProcessingError);
 }
 
+TEST(ChartDetection, EncodingForTheDetectorRoundsAsTheSrgbCurve) {
+  // srgb8_bgr_image's table must give the codes of rounding 255 * linear_to_srgb(v) to the nearest
+  // integer (floor(x + 0.5); saturate_cast would round x + 0.5 once more, one code too high for
+  // half of all values, as this function did before its table): values on a
+  // fine ramp, just below and above every code's rounding bound, out of range and NaN.
+  std::vector<float> values;
+  for (int i = 0; i <= 200000; ++i) values.push_back(float(i) / 200000.0f);
+  for (int k = 1; k <= 255; ++k) {
+    const float b = srgb_to_linear((float(k) - 0.5f) / 255.0f);
+    values.push_back(std::nextafter(b, 0.0f));
+    values.push_back(std::nextafter(b, 1.0f));
+  }
+  values.insert(values.end(), {-0.5f, 0.0f, 1.0f, 1.5f, std::numeric_limits<float>::quiet_NaN()});
+  cv::Mat img(1, int(values.size()), CV_32FC3);
+  for (size_t i = 0; i < values.size(); ++i) img.at<cv::Vec3f>(0, int(i)) = cv::Vec3f(values[i], 0.5f, 0.0f);
+  const cv::Mat out = srgb8_bgr_image(img);
+  int differ = 0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    const int expected = int(std::floor(255 * linear_to_srgb(values[i]) + 0.5f));
+    const int got = out.at<cv::Vec3b>(0, int(i))[2];  // BGR: red last
+    if (i <= 200000) differ += got != expected ? 1 : 0;
+    // One float step either side of a bound: the two computations may round either way.
+    ASSERT_LE(std::abs(got - expected), 1) << values[i];
+  }
+  EXPECT_LE(differ, 8);  // of the ramp's 200 001 values
+  EXPECT_EQ(int(out.at<cv::Vec3b>(0, 0)[1]), int(std::floor(255 * linear_to_srgb(0.5f) + 0.5f)));
+}
+
 TEST(ChartDetection, SyntheticChartIsFoundAndMeasured) {
   cv::Mat img = background(640, 480, 1);
   draw_chart(img, kQuad, 0.9);
@@ -210,6 +240,26 @@ TEST(ChartDetection, SyntheticChartIsFoundAndMeasured) {
     const auto expected = cast(r, 0.9);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.rgb[k][c], expected[c], 0.004 + 0.01 * expected[c]) << k;
   }
+}
+
+TEST(ChartDetection, LargePhotosAreSearchedReducedAndLocatedAtFullSize) {
+  // A 4200 x 2800 photo (searched at 1/3 of its size) with a chart of 60-pixel patches off centre:
+  // found, and its corners as precise as in a small photo (the full-size pass around the spot),
+  // not the reduced search's 3-pixel steps. The corners of an unrefined 1/3 search would also pass
+  // 3 x 6.5 px, so the bound here is the small photo's.
+  const std::array<cv::Point2f, 4> quad = {{{2300, 1500}, {2700, 1520}, {2690, 1790}, {2290, 1770}}};
+  cv::Mat img = background(4200, 2800, 5);
+  draw_chart(img, quad, 0.9);
+  std::vector<std::string> log;
+  const std::vector<ChartLocation> found = detect_charts(srgb8_bgr_image(img), 1, log);
+  ASSERT_EQ(found.size(), 1u);
+  const auto truth = corner_patch_centres(quad);
+  for (int i = 0; i < 4; ++i) EXPECT_LT(cv::norm(found[0].corners[i] - truth[i]), 6.5) << i;
+  for (const std::string &line : log)
+    EXPECT_EQ(line.find("not found again at full size"), std::string::npos) << line;
+  // The same photo without the chart: nothing found.
+  log.clear();
+  EXPECT_TRUE(detect_charts(srgb8_bgr_image(background(4200, 2800, 5)), 1, log).empty());
 }
 
 TEST(ChartDetection, UpsideDownChartIsTurned) {

@@ -17,6 +17,8 @@ namespace {
 
 // mcc's ColorChecker Classic template: the detector's box is 16.75 x 11.25 units (CChartModel
 // MCC24); patch centres at 1.5 + 2.75 k in it (checked within 4 px on the Mitsuba scenes' charts).
+// Photos longer than this are searched for a chart at a reduced size first (detect_charts).
+constexpr int kDetectSide = 2048;
 constexpr float kBoxW = 16.75f, kBoxH = 11.25f, kFirstCentre = 1.5f, kPitch = 2.75f;
 
 std::string fmt(const char *format, double a = 0, double b = 0, double c = 0, double d = 0) {
@@ -428,12 +430,38 @@ ChartLocation chart_from_corners(const float xy[8]) {
 
 cv::Mat srgb8_bgr_image(const cv::Mat &linear_rgb) {
   CV_Assert(linear_rgb.type() == CV_32FC3);
+  // Code k is the largest whose lower rounding bound srgb_to_linear((k - 0.5) / 255) the value
+  // reaches: 255 * linear_to_srgb(v) rounded to the nearest code, without a pow() per channel
+  // (the chart search converts 12-50 MP photos). A 65536-bucket table gives the code at a
+  // bucket's low end; the bounds are further apart than a bucket (>= 1.5e-4 > 1.5e-5), so at most
+  // one lies inside it: one comparison finishes the job.
+  struct Encoder {
+    std::array<float, 256> bound{};      // bound[k]: lowest value of code k (bound[0] = 0)
+    std::array<uint8_t, 65537> code{};   // code at i / 65536
+    Encoder() {
+      for (int k = 1; k <= 255; ++k) bound[size_t(k)] = srgb_to_linear((float(k) - 0.5f) / 255.0f);
+      int k = 0;
+      for (size_t i = 0; i < code.size(); ++i) {
+        const float v = float(i) / 65536.0f;
+        while (k < 255 && v >= bound[size_t(k + 1)]) ++k;
+        code[i] = uint8_t(k);
+      }
+    }
+    uint8_t operator()(float v) const {
+      if (!(v > 0)) return 0;  // also NaN
+      if (v >= 1) return 255;
+      const uint8_t k = code[size_t(v * 65536.0f)];
+      return k < 255 && v >= bound[size_t(k) + 1] ? uint8_t(k + 1) : k;
+    }
+  };
+  static const Encoder encode;
   cv::Mat out(linear_rgb.size(), CV_8UC3);
+#pragma omp parallel for schedule(static)
   for (int y = 0; y < linear_rgb.rows; ++y) {
     const cv::Vec3f *in = linear_rgb.ptr<cv::Vec3f>(y);
     cv::Vec3b *o = out.ptr<cv::Vec3b>(y);
     for (int x = 0; x < linear_rgb.cols; ++x)
-      for (int c = 0; c < 3; ++c) o[x][2 - c] = cv::saturate_cast<uchar>(255 * linear_to_srgb(in[x][c]) + 0.5f);
+      for (int c = 0; c < 3; ++c) o[x][2 - c] = encode(in[x][c]);
   }
   return out;
 }
@@ -452,7 +480,8 @@ cv::Mat linear_rgb_image(const cv::Mat &image, bool bgr, bool decode_srgb) {
   }
 }
 
-std::vector<ChartLocation> detect_charts(const cv::Mat &bgr8, int max_charts, std::vector<std::string> &log) {
+namespace {
+std::vector<ChartLocation> detect_charts_at_full_size(const cv::Mat &bgr8, int max_charts, std::vector<std::string> &log) {
   std::vector<ChartLocation> out;
   CV_Assert(bgr8.type() == CV_8UC3);
   cv::Ptr<cv::mcc::CCheckerDetector> det = cv::mcc::CCheckerDetector::create();
@@ -486,6 +515,51 @@ std::vector<ChartLocation> detect_charts(const cv::Mat &bgr8, int max_charts, st
     out.push_back(loc);
     if (int(out.size()) >= max_charts) break;
   }
+  std::sort(out.begin(), out.end(), [](const ChartLocation &a, const ChartLocation &b) { return a.cost < b.cost; });
+  return out;
+}
+
+// The chart `coarse` (found in the photo reduced by `scale`) located again at full resolution in
+// a window around it; the coarse location, scaled, when the detector misses it there.
+ChartLocation refine_chart(const cv::Mat &bgr8, const ChartLocation &coarse, cv::Point2f scale, int factor,
+                           std::vector<std::string> &log) {
+  ChartLocation scaled = coarse;
+  for (cv::Point2f &p : scaled.corners) p = cv::Point2f(p.x * scale.x, p.y * scale.y);  // continuous pixel coordinates
+  cv::Rect2f box = cv::boundingRect(std::vector<cv::Point2f>(scaled.corners.begin(), scaled.corners.end()));
+  // The corner patches' centres span 5 x 3 pitches; the chart's frame lies within a pitch of them.
+  const float margin = 0.5f * std::max(box.width, box.height);
+  const cv::Rect window = cv::Rect(cv::Point(int(box.x - margin), int(box.y - margin)),
+                                   cv::Point(int(box.x + box.width + margin) + 1, int(box.y + box.height + margin) + 1)) &
+                          cv::Rect(0, 0, bgr8.cols, bgr8.rows);
+  std::vector<std::string> lines;
+  std::vector<ChartLocation> found = detect_charts_at_full_size(bgr8(window).clone(), 1, lines);
+  if (found.empty()) {
+    log.push_back(fmt("ColorChecker: located at 1/%.0f of the photo's size only (not found again at full size).", factor));
+    return scaled;
+  }
+  ChartLocation fine = found.front();
+  for (cv::Point2f &p : fine.corners) p += cv::Point2f(float(window.x), float(window.y));
+  log.insert(log.end(), lines.begin(), lines.end());
+  return fine;
+}
+} // namespace
+
+std::vector<ChartLocation> detect_charts(const cv::Mat &bgr8, int max_charts, std::vector<std::string> &log) {
+  // The detector's time grows with the pixel count, and a chart needs far fewer pixels than a
+  // 12-50 MP photo has: larger photos are searched at a reduced size first (a photo without a
+  // chart, the common case, costs only that), then each chart found is located again at full
+  // resolution in a window around it, so its corners keep full-resolution precision. (Reduced
+  // from the 8-bit encoded photo: averaged in linear light, the dark gaps between patches fade
+  // and the detector misses charts it finds here.)
+  CV_Assert(bgr8.type() == CV_8UC3);
+  const int longer = std::max(bgr8.cols, bgr8.rows);
+  if (longer <= kDetectSide) return detect_charts_at_full_size(bgr8, max_charts, log);
+  const int factor = (longer + kDetectSide - 1) / kDetectSide;
+  cv::Mat reduced;
+  cv::resize(bgr8, reduced, cv::Size(bgr8.cols / factor, bgr8.rows / factor), 0, 0, cv::INTER_AREA);
+  std::vector<ChartLocation> out = detect_charts_at_full_size(reduced, max_charts, log);
+  const cv::Point2f scale(float(bgr8.cols) / float(reduced.cols), float(bgr8.rows) / float(reduced.rows));
+  for (ChartLocation &chart : out) chart = refine_chart(bgr8, chart, scale, factor, log);
   std::sort(out.begin(), out.end(), [](const ChartLocation &a, const ChartLocation &b) { return a.cost < b.cost; });
   return out;
 }

@@ -54,6 +54,8 @@ ChartLocation chart_from_corners(const float xy[8]);
 // ColorChecker Classic charts found by cv::mcc::CCheckerDetector in an 8-bit BGR photo (as from
 // cv::imread; other depths/orders: see srgb8_bgr_image()), best first, at most `max_charts`.
 // Each chart's orientation is checked on its neutral row. Appends one log line per chart.
+// Photos longer than 2048 pixels are searched at 1/k of their size (k the smallest integer that
+// brings them to 2048) and each chart found is located again at full size around that spot.
 std::vector<ChartLocation> detect_charts(const cv::Mat &bgr8, int max_charts, std::vector<std::string> &log);
 
 // 8-bit sRGB-encoded BGR image (what the detector wants) from a linear RGB float image.

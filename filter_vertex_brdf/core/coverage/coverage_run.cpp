@@ -238,7 +238,8 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
   log("Lights: " + describe_lights(sources, placement) + " from '" + r.light_file + "'" +
       (unused.empty() ? std::string(".") : " (" + std::to_string(unused.size()) + " entries for photos not imported yet)."));
 
-  PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
+  PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes,
+                    settings.gather.host_photos);
   const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);  // as the fit
 
   auto t = Clock::now();

@@ -1,6 +1,7 @@
 #include "fit/pipeline.h"
 
 #include <algorithm>
+#include <exception>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -207,16 +208,19 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
 
   // The photos decode in the background while the GL passes run (photo_prefetch.h); a photo that
   // cannot be decoded fails before any sample is gathered, so before anything is written.
-  PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes);
+  PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes,
+                    settings.gather.host_photos);
   const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);
   // Before the long passes: a required chart that is missing fails early.
   if (progress) progress(0.0f, "colour calibration");
+  auto t = Clock::now();
   ColorPlan colors = plan_colors(input, settings, light_directions(lights), photos, log);
+  result.seconds_colors = seconds_since(t);
   const bool correct = colors.any_corrected();
   result.color_viewpoints_corrected = size_t(std::count_if(
       colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
 
-  auto t = Clock::now();
+  t = Clock::now();
   const ProgressFn vis_progress = [&](float f, const char *s) { return !progress || progress(0.4f * f, s); };
   VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
   {
@@ -228,14 +232,25 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   restrict_to_vertices(masks, input.vertex_mask);
   result.seconds_visibility = seconds_since(t);
   prefetch->finish();
+  t = Clock::now();
   // Every photo's content (photo_content.h), before any sample is gathered: mostly from the cache.
-  std::vector<PhotoContent> contents;
-  size_t largest_photo = 0;
-  for (const Raster &r : input.rasters) {
-    const auto photo = photos.get(r.image_path, r.width(), r.height());
-    contents.push_back(analyse_photo(*photo));
-    largest_photo = std::max(largest_photo, photo->pixels.total() * photo->pixels.elemSize());
+  std::vector<PhotoContent> contents(input.rasters.size());
+  std::vector<size_t> photo_bytes(input.rasters.size(), 0);
+  std::vector<std::exception_ptr> photo_errors(input.rasters.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long long i = 0; i < (long long)input.rasters.size(); ++i) {
+    const Raster &r = input.rasters[size_t(i)];
+    try {
+      const auto photo = photos.get(r.image_path, r.width(), r.height());
+      contents[size_t(i)] = analyse_photo(*photo);
+      photo_bytes[size_t(i)] = photo->owner ? 0 : photo->pixels.total() * photo->pixels.elemSize();  // host images: not ours
+    } catch (...) {
+      photo_errors[size_t(i)] = std::current_exception();
+    }
   }
+  for (const std::exception_ptr &e : photo_errors)  // the first failing photo, in raster order
+    if (e) std::rethrow_exception(e);
+  const size_t largest_photo = photo_bytes.empty() ? 0 : *std::max_element(photo_bytes.begin(), photo_bytes.end());
   if (largest_photo > settings.gather.photo_cache_bytes) {
     result.memory_note = "photo memory: a decoded photo needs " + std::to_string((largest_photo >> 20) + 1) +
                          " MB, more than 'Photo memory (MB)' (" + std::to_string(settings.gather.photo_cache_bytes >> 20) +
@@ -257,10 +272,14 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
       log(result.warnings.back());
     }
 
+  result.seconds_photo_checks = seconds_since(t);
+
+  t = Clock::now();
   decide_diffuse_form(input, lights, masks, photos, [&](SampleChunk &chunk) {
     if (correct) correct_samples(colors, chunk);
     apply_light_falloff(chunk, mesh, lights);
   }, log, settings, result);
+  result.seconds_pilot = seconds_since(t);
 
   t = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
@@ -283,8 +302,12 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   result.light_agreement = weakest_light_agreement(agreement, input.rasters);
   check_light_agreement(agreement, input.rasters, result.light_file);  // before anything is written
   result.colors = std::move(colors.viewpoints);
+  t = Clock::now();
   if (with_materials) run_material_stage(input, settings, material_samples, log, result);
+  result.seconds_materials = seconds_since(t);
+  t = Clock::now();
   if (settings.fit_reflectance) fill_gaps(input, settings, log, result);
+  result.seconds_fill = seconds_since(t);
   if (with_materials) propagate_material_labels(mesh, result.fits, result.materials.label);
 
   t = Clock::now();

@@ -22,29 +22,28 @@ float linear_to_srgb(float c) {
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
-Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level, int expected_width,
-                 int expected_height) {
-  if (!file_exists(path))
-    throw InputError("Photo '" + path + "' is missing: restore it or fix the raster's path in the project.");
-  cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (raw.empty()) throw InputError("Photo '" + path + "' cannot be decoded (unsupported or damaged file).");
-  if (raw.depth() != CV_8U && raw.depth() != CV_16U)
-    throw InputError("Photo '" + path + "' is neither 8- nor 16-bit per channel: convert it to 8-bit sRGB or "
-                     "16-bit linear PNG/TIFF.");
-  Photo photo;
-  photo.path = path;
-  switch (raw.channels()) {
-  case 1: cv::cvtColor(raw, photo.pixels, cv::COLOR_GRAY2RGB); break;
-  case 3: cv::cvtColor(raw, photo.pixels, cv::COLOR_BGR2RGB); break;
-  case 4: cv::cvtColor(raw, photo.pixels, cv::COLOR_BGRA2RGB); break;
-  default: throw InputError("Photo '" + path + "' has " + std::to_string(raw.channels()) + " channels; expected RGB.");
-  }
-  if (expected_width > 0 && (photo.width() != expected_width || photo.height() != expected_height))
-    throw InputError("Photo '" + path + "' is " + std::to_string(photo.width()) + "x" + std::to_string(photo.height()) +
-                     " but its raster's camera expects " + std::to_string(expected_width) + "x" +
-                     std::to_string(expected_height) + ": use the photo the camera was registered with.");
+namespace {
 
-  const bool sixteen = raw.depth() == CV_16U;
+// Where R, G and B sit in a pixel of `channels` codes as OpenCV and Qt store them; channels
+// beyond the colour ones (alpha) are ignored.
+bool rgb_layout(int channels, bool bgr_order, std::array<int, 3> &rgb) {
+  if (channels == 1 || channels == 2) rgb = {{0, 0, 0}};
+  else if (channels == 3 || channels == 4) rgb = bgr_order ? std::array<int, 3>{{2, 1, 0}} : std::array<int, 3>{{0, 1, 2}};
+  else return false;
+  return true;
+}
+
+void check_size(const Photo &photo, int expected_width, int expected_height) {
+  if (expected_width > 0 && (photo.width() != expected_width || photo.height() != expected_height))
+    throw InputError("Photo '" + photo.path + "' is " + std::to_string(photo.width()) + "x" +
+                     std::to_string(photo.height()) + " but its raster's camera expects " +
+                     std::to_string(expected_width) + "x" + std::to_string(expected_height) +
+                     ": use the photo the camera was registered with.");
+}
+
+// The decoding table and saturation code of a photo whose codes are `pixels`' depth.
+void set_decoding(Photo &photo, PhotoEncoding encoding, float saturation_level) {
+  const bool sixteen = photo.pixels.depth() == CV_16U;
   const int max_code = sixteen ? 65535 : 255;
   photo.linear = encoding == PhotoEncoding::Linear || (encoding == PhotoEncoding::Auto && sixteen);
   photo.lut.resize(size_t(max_code) + 1);
@@ -53,6 +52,44 @@ Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturati
     photo.lut[size_t(c)] = photo.linear ? v : srgb_to_linear(v);
   }
   photo.saturation_code = std::max(1, int(std::ceil(saturation_level * max_code - 1e-3f)));
+}
+
+} // namespace
+
+Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level, int expected_width,
+                 int expected_height) {
+  if (!file_exists(path))
+    throw InputError("Photo '" + path + "' is missing: restore it or fix the raster's path in the project.");
+  Photo photo;
+  photo.path = path;
+  // Kept as decoded (BGR order): no conversion pass and no second copy of the photo.
+  photo.pixels = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (photo.pixels.empty()) throw InputError("Photo '" + path + "' cannot be decoded (unsupported or damaged file).");
+  if (photo.pixels.depth() != CV_8U && photo.pixels.depth() != CV_16U)
+    throw InputError("Photo '" + path + "' is neither 8- nor 16-bit per channel: convert it to 8-bit sRGB or "
+                     "16-bit linear PNG/TIFF.");
+  if (!rgb_layout(photo.pixels.channels(), true, photo.rgb))
+    throw InputError("Photo '" + path + "' has " + std::to_string(photo.pixels.channels()) +
+                     " channels; expected RGB.");
+  check_size(photo, expected_width, expected_height);
+  set_decoding(photo, encoding, saturation_level);
+  return photo;
+}
+
+Photo photo_from_host(const std::string &path, const HostPixels &host, PhotoEncoding encoding, float saturation_level,
+                      int expected_width, int expected_height) {
+  Photo photo;
+  photo.path = path;
+  photo.pixels = host.pixels;
+  photo.rgb = host.rgb;
+  photo.owner = host.owner;
+  const int n = photo.pixels.channels();
+  const bool rgb_inside = std::all_of(host.rgb.begin(), host.rgb.end(), [n](int c) { return c >= 0 && c < n; });
+  if (photo.pixels.empty() || (photo.pixels.depth() != CV_8U && photo.pixels.depth() != CV_16U) || n > 4 || !rgb_inside)
+    throw InputError("Photo '" + path + "': the host application's decoded image is not 8/16-bit RGB or grey; "
+                     "convert the photo to 8-bit sRGB or 16-bit linear PNG/TIFF.");
+  check_size(photo, expected_width, expected_height);
+  set_decoding(photo, encoding, saturation_level);
   return photo;
 }
 
@@ -74,12 +111,14 @@ PixelSample bilinear(const Photo &photo, float x, float y, uint8_t texels) {
   total = 0;
   for (float wk : w) total += wk;
   const T *rows[2] = {photo.pixels.ptr<T>(y0), photo.pixels.ptr<T>(y0 + 1)};
+  const int n = photo.pixels.channels();
   for (int k = 0; k < 4; ++k) {
     if (w[k] == 0 && texels != 0xF) continue;
-    const T *px = rows[k / 2] + 3 * (x0 + (k % 2));
+    const T *px = rows[k / 2] + n * (x0 + (k % 2));
     for (int c = 0; c < 3; ++c) {
-      if (int(px[c]) >= photo.saturation_code) out.saturated = true;
-      out.rgb[c] += w[k] / total * photo.lut[px[c]];
+      const T code = px[photo.rgb[size_t(c)]];
+      if (int(code) >= photo.saturation_code) out.saturated = true;
+      out.rgb[c] += w[k] / total * photo.lut[code];
     }
   }
   return out;
@@ -91,13 +130,16 @@ cv::Mat photo_linear_rgb(const Photo &photo, cv::Mat *clipped) {
   cv::Mat linear(h, w, CV_32FC3);
   if (clipped) clipped->create(h, w, CV_8U);
   const bool wide = photo.pixels.depth() == CV_16U;
+  const int n = photo.pixels.channels();
+#pragma omp parallel for schedule(static)
   for (int y = 0; y < h; ++y) {
     float *out = linear.ptr<float>(y);
     uint8_t *clip = clipped ? clipped->ptr<uint8_t>(y) : nullptr;
     for (int x = 0; x < w; ++x) {
       bool any = false;
       for (int c = 0; c < 3; ++c) {
-        const int code = wide ? photo.pixels.ptr<uint16_t>(y)[3 * x + c] : photo.pixels.ptr<uint8_t>(y)[3 * x + c];
+        const int i = n * x + photo.rgb[size_t(c)];
+        const int code = wide ? photo.pixels.ptr<uint16_t>(y)[i] : photo.pixels.ptr<uint8_t>(y)[i];
         out[3 * x + c] = photo.lut[size_t(code)];
         any = any || code >= photo.saturation_code;
       }
@@ -139,8 +181,9 @@ PixelSample sample_bilinear(const Photo &photo, float x, float y, uint8_t texels
                                         : bilinear<uint8_t>(photo, x, y, texels);
 }
 
-PhotoCache::PhotoCache(PhotoEncoding encoding, float saturation_level, size_t budget_bytes)
-    : encoding_(encoding), saturation_level_(saturation_level), budget_(budget_bytes) {}
+PhotoCache::PhotoCache(PhotoEncoding encoding, float saturation_level, size_t budget_bytes,
+                       std::shared_ptr<const HostPhotos> host)
+    : encoding_(encoding), saturation_level_(saturation_level), budget_(budget_bytes), host_(std::move(host)) {}
 
 std::shared_ptr<const Photo> PhotoCache::get(const std::string &path, int expected_width, int expected_height) {
   return load(path, expected_width, expected_height, false);
@@ -162,6 +205,16 @@ std::shared_ptr<const Photo> PhotoCache::load(const std::string &path, int expec
       }
     if (std::find(loading_.begin(), loading_.end(), path) == loading_.end()) break;
     loaded_.wait(lock);  // another thread decodes it
+  }
+  const auto host = host_ ? host_->find(path) : HostPhotos::const_iterator();
+  if (host_ && host != host_->end()) {
+    // Read in place: only its decoding table counts against the budget.
+    auto photo = std::make_shared<const Photo>(
+        photo_from_host(path, host->second, encoding_, saturation_level_, expected_width, expected_height));
+    ++host_reads_;
+    entries_.push_back({path, Entry{photo, photo->lut.size() * sizeof(float), ++tick_}});
+    used_ += entries_.back().second.bytes;
+    return photo;
   }
   // Room for it and for the photos being decoded, each as large as the largest so far (checked
   // with the decode registered under one lock, so that prefetching threads never overshoot).

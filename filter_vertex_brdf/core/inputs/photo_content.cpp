@@ -1,6 +1,7 @@
 #include "inputs/photo_content.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "base/errors.h"
@@ -17,21 +18,28 @@ PhotoContent analyse(const Photo &photo) {
   int dark_code = 0;  // the largest code below kDarkLevel
   while (dark_code + 1 < int(photo.lut.size()) && photo.lut[size_t(dark_code + 1)] < kDarkLevel) ++dark_code;
   uint64_t hash = 1469598103934665603ull;  // FNV-1a over the codes
-  size_t dark = 0, saturated = 0;
-  for (int y = 0; y < photo.height(); ++y) {
+  size_t dark = 0, saturated = 0, counted = 0;
+  // A grid of about a million pixels: the fractions are estimates against 99.5 % bounds, and any
+  // two photos under different lights differ nearly everywhere, so a 12-50 MP photo need not be
+  // read whole (every pixel up to 2 MP).
+  const int stride = std::max(1, int(std::sqrt(double(photo.width()) * double(photo.height()) / 1.0e6)));
+  for (int y = 0; y < photo.height(); y += stride) {
     const T *row = photo.pixels.ptr<T>(y);
-    for (int x = 0; x < photo.width(); ++x) {
-      const T *px = row + 3 * x;
+    const int n = photo.pixels.channels();
+    for (int x = 0; x < photo.width(); x += stride) {
+      ++counted;
+      const T *px = row + n * x;
       bool all_dark = true, any_clipped = false;
       for (int k = 0; k < 3; ++k) {
-        all_dark = all_dark && int(px[k]) <= dark_code;
-        any_clipped = any_clipped || int(px[k]) >= photo.saturation_code;
-        hash = (hash ^ uint64_t(px[k])) * 1099511628211ull;
+        const T code = px[photo.rgb[size_t(k)]];  // R, G, B whatever the layout: one fingerprint per content
+        all_dark = all_dark && int(code) <= dark_code;
+        any_clipped = any_clipped || int(code) >= photo.saturation_code;
+        hash = (hash ^ uint64_t(code)) * 1099511628211ull;
       }
       dark += all_dark, saturated += any_clipped;
     }
   }
-  const double pixels = double(std::max(1, photo.width() * photo.height()));
+  const double pixels = double(std::max<size_t>(1, counted));
   c.dark_fraction = double(dark) / pixels;
   c.saturated_fraction = double(saturated) / pixels;
   c.fingerprint = hash ^ (uint64_t(photo.width()) << 32) ^ uint64_t(photo.height());

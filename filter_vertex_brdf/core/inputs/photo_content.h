@@ -21,6 +21,7 @@ struct PhotoContent {
 constexpr float kDarkLevel = 0.002f;         // linear; 8-bit sRGB codes 0..6
 constexpr double kUselessFraction = 0.995;   // a photo this dark / saturated carries nothing
 
+// Reads every pixel of photos up to 2 MP, an even grid of about a million pixels of larger ones.
 PhotoContent analyse_photo(const Photo &photo);
 
 // Checks the photos of `rasters` (contents[i] of rasters[i]). Throws InputError, naming a photo of

@@ -200,7 +200,11 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   rep << "\n";
   rep << "time: visibility " << fixed(r.seconds_visibility) << " s, samples " << fixed(r.seconds_gather - r.seconds_fit)
       << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
+      << g.host_photo_reads << " photos read from MeshLab's images, "
       << g.rasters_skipped << " raster x chunk pairs skipped)\n";
+  rep << "time, other stages: colour chart search and correction " << fixed(r.seconds_colors) << " s, photo checks "
+      << fixed(r.seconds_photo_checks) << " s, diffuse-form pilot " << fixed(r.seconds_pilot) << " s, materials "
+      << fixed(r.seconds_materials) << " s, neighbour fill " << fixed(r.seconds_fill) << " s\n";
   return rep.str();
 }
 

@@ -299,6 +299,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     stats.flag_counts[bit_index(kOccluded)] += masks.occluded[r];
   }
   stats.photo_loads = photos.loads();
+  stats.host_photo_reads = photos.host_reads();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }

@@ -85,6 +85,9 @@ struct GatherSettings {
   PhotoEncoding encoding = PhotoEncoding::Auto;
   float saturation_level = 0.99f;    // fraction of the maximum code value counted as clipped
   size_t photo_cache_bytes = size_t(2) << 30;  // decoded photos kept in memory
+  // Photos the host application has already decoded (the plugin: MeshLab's raster images), read
+  // in place instead of decoded again; they take none of photo_cache_bytes. Empty: decode files.
+  std::shared_ptr<const HostPhotos> host_photos;
   size_t chunk_sample_bytes = size_t(256) << 20; // target size of one chunk's samples
   // Where a vertex's 2x2 bilinear footprint straddles a depth jump (silhouette, contact), take
   // the colour from the footprint texels on the vertex's own surface, re-weighted (the fit's
@@ -166,7 +169,8 @@ struct GatherStats {
   std::vector<uint32_t> raster_seen_vertices;  // per raster: vertices it sees
   size_t chunks = 0;
   size_t rasters_skipped = 0;     // raster x chunk pairs skipped because the raster sees no vertex there
-  size_t photo_loads = 0;
+  size_t photo_loads = 0;         // photo files decoded
+  size_t host_photo_reads = 0;    // photos read in place from the host's decoded images (GatherSettings::host_photos)
   double seconds = 0;
 };
 

@@ -224,7 +224,7 @@ CandidateSet gather_candidates(const MeshView &mesh, const std::vector<Raster> &
   for (size_t v = 0; v < mesh.vertex_count; ++v) set.visible[v] = masks.is_seen(0, v) && masks.own_texels(0, v) != 0;
   set.diffuse.assign(set.words * rasters.size(), 0);
   set.specular.assign(set.words * rasters.size(), 0);
-  PhotoCache photos(gather.encoding, gather.saturation_level, gather.photo_cache_bytes);
+  PhotoCache photos(gather.encoding, gather.saturation_level, gather.photo_cache_bytes, gather.host_photos);
   gather_samples(
       mesh, rasters, sources, masks, gather, photos,
       [&](const SampleChunk &chunk) {
