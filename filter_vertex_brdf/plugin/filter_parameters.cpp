@@ -189,7 +189,8 @@ void add_photo_and_visibility(RichParameterList &params) {
   add_shadow_map_size(params);
   params.addParam(RichInt(kMemoryBudgetMB, int(vbrdf::GatherSettings().photo_cache_bytes >> 20), "Photo memory (MB)",
                           "Decoded photos kept in memory at once; photos beyond it are reloaded when "
-                          "needed. At least 16."));
+                          "needed. The rasters' images MeshLab has already loaded are read in place and "
+                          "take none of it. At least 16."));
 }
 
 void read_gather(const RichParameterList &params, vbrdf::GatherSettings &gather) {

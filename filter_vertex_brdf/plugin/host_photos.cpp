@@ -1,5 +1,8 @@
 #include "host_photos.h"
 
+#include <algorithm>
+#include <fstream>
+
 #include <QtGlobal>
 
 #include "meshlab_bridge.h"  // utf8
@@ -39,13 +42,24 @@ bool host_pixels_of(const QImage &image, vbrdf::HostPixels &out) {
   return true;
 }
 
+bool qt_keeps_the_photos_depth(const std::string &path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[8] = {0};
+  if (!in.read(reinterpret_cast<char *>(head), sizeof head)) return false;
+  const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  const bool is_png = std::equal(head, head + 8, png);
+  const bool is_jpeg = head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF;
+  return is_png || is_jpeg;
+}
+
 std::shared_ptr<const vbrdf::HostPhotos> host_photos(const MeshDocument &document) {
   auto photos = std::make_shared<vbrdf::HostPhotos>();
   for (const RasterModel *rm : document.rasterList) {
     if (rm == nullptr || rm->planeList.empty() || rm->planeList.first() == nullptr) continue;
     const Plane &plane = *rm->planeList.first();
+    const std::string path = utf8(plane.fullPathFileName);
     vbrdf::HostPixels pixels;
-    if (host_pixels_of(plane.image, pixels)) (*photos)[utf8(plane.fullPathFileName)] = pixels;
+    if (qt_keeps_the_photos_depth(path) && host_pixels_of(plane.image, pixels)) (*photos)[path] = pixels;
   }
   return photos;
 }

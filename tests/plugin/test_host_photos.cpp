@@ -92,6 +92,21 @@ TEST(HostPhotos, MeshLabsImagesDecodeAsTheFitsOwnDecoder) {
   }
 }
 
+TEST(HostPhotos, OnlyFormatsQtDecodesAtTheirOwnDepthAreTaken) {
+  // PNG (Qt >= 5.12 keeps 16-bit) and JPEG (8-bit only) by their signature, whatever the name;
+  // TIFF and the rest are decoded by the core (a Qt plugin might reduce 16-bit TIFFs to 8 bits).
+  const std::string png = scratch("sig.tif"), jpeg = scratch("sig_jpeg.png"), tiff = scratch("sig.tiff");
+  ASSERT_TRUE(cv::imwrite(scratch("sig_tmp.png"), pattern(CV_16U, 3)));
+  ASSERT_EQ(std::rename(scratch("sig_tmp.png").c_str(), png.c_str()), 0);  // a PNG named .tif
+  ASSERT_TRUE(cv::imwrite(scratch("sig_tmp.jpg"), pattern(CV_8U, 3)));
+  ASSERT_EQ(std::rename(scratch("sig_tmp.jpg").c_str(), jpeg.c_str()), 0);
+  ASSERT_TRUE(cv::imwrite(tiff, pattern(CV_16U, 3)));
+  EXPECT_TRUE(vbrdf_plugin::qt_keeps_the_photos_depth(png));
+  EXPECT_TRUE(vbrdf_plugin::qt_keeps_the_photos_depth(jpeg));
+  EXPECT_FALSE(vbrdf_plugin::qt_keeps_the_photos_depth(tiff));
+  EXPECT_FALSE(vbrdf_plugin::qt_keeps_the_photos_depth(scratch("missing.png")));
+}
+
 TEST(HostPhotos, ACacheGivenTheImagesReadsNoFile) {
   const std::string path = scratch("host_cache.png");
   ASSERT_TRUE(cv::imwrite(path, pattern(CV_8U, 3)));

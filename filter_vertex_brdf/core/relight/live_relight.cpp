@@ -100,9 +100,6 @@ void main() {
 }
 )";
 
-constexpr int kFloatsPerVertex = 16;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, coated 1,
-                                      // status/dq/sq 3
-
 // Inverse of the upper-left 3x3 of a column-major 4x4; false when singular.
 bool invert_linear_part(const double m[16], double inv[9]) {
   auto a = [&](int r, int c) { return m[c * 4 + r]; };
@@ -159,9 +156,9 @@ private:
   GlApi gl_;
   LobeForm lobe_;
   DiffuseForms diffuse_;
-  size_t index_count_ = 0;
+  PhongMeshBuffers mesh_;
   double origin_[3] = {0, 0, 0};
-  GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+  GLuint program_ = 0;
   GlRenderTarget target_;
 };
 
@@ -188,50 +185,14 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
 }
 
 void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
-  const float alpha_default = typical_shininess(fits);
-  std::vector<float> data(mesh.vertex_count * kFloatsPerVertex);
-  for (size_t v = 0; v < mesh.vertex_count; ++v) {
-    float *o = &data[v * kFloatsPerVertex];
-    const VertexFit &f = fits[v];
-    for (int k = 0; k < 3; ++k) {
-      o[k] = float(double(mesh.positions[3 * v + k]) - origin_[k]);
-      o[3 + k] = mesh.normals[3 * v + k];
-      o[6 + k] = f.kd * f.color[k];
-    }
-    o[9] = f.status == kFitNone ? 0.0f : 1.0f;
-    o[10] = f.ks;
-    o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
-    o[12] = diffuse_.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
-    o[13] = float(f.status);
-    o[14] = std::isfinite(f.dq) ? f.dq : 0.0f;
-    o[15] = std::isfinite(f.sq) ? f.sq : 0.0f;
-  }
-  index_count_ = mesh.index_count;
-  gl_.GenVertexArrays(1, &vao_);
-  gl_.BindVertexArray(vao_);
-  gl_.GenBuffers(1, &vbo_);
-  gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
-  gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
-  const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[5] = {3, 3, 4, 3, 3}, offsets[5] = {0, 3, 6, 10, 13};
-  for (GLuint a = 0; a < 5; ++a) {
-    gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
-                            reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
-    gl_.EnableVertexAttribArray(a);
-  }
-  gl_.GenBuffers(1, &ibo_);
-  gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);  // recorded in our VAO only
-  gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.index_count * sizeof(uint32_t)), mesh.indices,
-                 GL_STATIC_DRAW);
+  mesh_ = upload_phong_mesh(gl_, mesh, origin_, fits, diffuse_);
 }
 
 void LiveRelight::Impl::release() {
   release_render_target(gl_, target_);
-  if (vao_) gl_.DeleteVertexArrays(1, &vao_);
-  if (vbo_) gl_.DeleteBuffers(1, &vbo_);
-  if (ibo_) gl_.DeleteBuffers(1, &ibo_);
+  release_phong_mesh(gl_, mesh_);
   if (program_) gl_.DeleteProgram(program_);
-  vao_ = vbo_ = ibo_ = program_ = 0;
+  program_ = 0;
 }
 
 void LiveRelight::Impl::draw(const LiveView &view) {
@@ -290,8 +251,8 @@ void LiveRelight::Impl::draw(const LiveView &view) {
   colors.clear();
   for (const LegendEntry &e : quality_legend()) colors.insert(colors.end(), e.rgb.begin(), e.rgb.end());
   gl_.Uniform3fv(gl_.GetUniformLocation(p, "u_quality_stops"), GLsizei(colors.size() / 3), colors.data());
-  gl_.BindVertexArray(vao_);
-  if (index_count_ > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(index_count_), GL_UNSIGNED_INT, nullptr);
+  gl_.BindVertexArray(mesh_.vao);
+  if (mesh_.index_count > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(mesh_.index_count), GL_UNSIGNED_INT, nullptr);
   check_gl_error(gl_, "the live relighting pass");
 }
 

@@ -33,4 +33,53 @@ float typical_shininess(const std::vector<VertexFit> &fits) {
   return a[a.size() / 2];
 }
 
+PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
+                                   const std::vector<VertexFit> &fits, const DiffuseForms &diffuse) {
+  constexpr int kFloats = 16;
+  const float alpha_default = typical_shininess(fits);
+  std::vector<float> data(mesh.vertex_count * kFloats);
+  for (size_t v = 0; v < mesh.vertex_count; ++v) {
+    float *o = &data[v * kFloats];
+    const VertexFit &f = fits[v];
+    for (int k = 0; k < 3; ++k) {
+      o[k] = float(double(mesh.positions[3 * v + k]) - origin[k]);
+      o[3 + k] = mesh.normals[3 * v + k];
+      o[6 + k] = f.kd * f.color[k];
+    }
+    o[9] = f.status == kFitNone ? 0.0f : 1.0f;
+    o[10] = f.ks;
+    o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
+    o[12] = diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
+    o[13] = float(f.status);
+    o[14] = std::isfinite(f.dq) ? f.dq : 0.0f;
+    o[15] = std::isfinite(f.sq) ? f.sq : 0.0f;
+  }
+  PhongMeshBuffers b;
+  b.index_count = mesh.index_count;
+  gl.GenVertexArrays(1, &b.vao);
+  gl.BindVertexArray(b.vao);
+  gl.GenBuffers(1, &b.vbo);
+  gl.BindBuffer(GL_ARRAY_BUFFER, b.vbo);
+  gl.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
+  const GLsizei stride = kFloats * sizeof(float);
+  const int sizes[5] = {3, 3, 4, 3, 3}, offsets[5] = {0, 3, 6, 10, 13};
+  for (GLuint a = 0; a < 5; ++a) {
+    gl.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
+                           reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
+    gl.EnableVertexAttribArray(a);
+  }
+  gl.GenBuffers(1, &b.ibo);
+  gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, b.ibo);  // recorded in our VAO only
+  gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.index_count * sizeof(uint32_t)), mesh.indices,
+                GL_STATIC_DRAW);
+  return b;
+}
+
+void release_phong_mesh(const GlApi &gl, PhongMeshBuffers &b) {
+  if (b.vao) gl.DeleteVertexArrays(1, &b.vao);
+  if (b.vbo) gl.DeleteBuffers(1, &b.vbo);
+  if (b.ibo) gl.DeleteBuffers(1, &b.ibo);
+  b = PhongMeshBuffers();
+}
+
 } // namespace vbrdf

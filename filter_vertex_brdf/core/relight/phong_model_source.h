@@ -2,10 +2,13 @@
 // The shared Phong model shader (shaders/phong_model.glsl, embedded in the library) and what its
 // users share on the CPU side: the relight renderer (relight_render.h) and the live view
 // (live_relight.h) build their fragment shaders as phong_program_source(their main), set the
-// model's uniforms with set_phong_model_uniforms and give k_s = 0 vertices typical_shininess.
+// model's uniforms with set_phong_model_uniforms, and draw the fit from one vertex buffer
+// (upload_phong_mesh; k_s = 0 vertices get typical_shininess).
+#include <cstddef>
 #include <string>
 #include <vector>
 
+#include "base/mesh_view.h"
 #include "fit/phong_fit.h"
 #include "samples/diffuse_form.h"
 #include "samples/lobe.h"
@@ -26,5 +29,23 @@ void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe);
 // The shininess given to k_s = 0 vertices: the median of the fitted lobes (k_s > 0, alpha > 0,
 // finite), 1 when there is none.
 float typical_shininess(const std::vector<VertexFit> &fits);
+
+// The fitted mesh as both renderers draw it: one interleaved buffer, 16 floats per vertex, at
+// attribute locations
+//   0 vec3 position, relative to `origin` (precision of far-from-origin coordinates)
+//   1 vec3 normal (as stored)
+//   2 vec4 (k_d C, fitted: 0 for fit_status 0, else 1)
+//   3 vec3 (k_s, alpha: typical_shininess where k_s = 0, coated: 1 where diffuse[v] is Coated)
+//   4 vec3 (fit_status, DQ, SQ; NaN quality as 0): the live view's false colours
+// and the mesh's indices, recorded in a new vertex array object (left bound). `fits` and
+// `diffuse` have one entry per vertex.
+struct PhongMeshBuffers {
+  unsigned vao = 0, vbo = 0, ibo = 0;
+  size_t index_count = 0;
+};
+PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
+                                   const std::vector<VertexFit> &fits, const DiffuseForms &diffuse);
+// Deletes what upload_phong_mesh created (zero handles are skipped) and zeroes `buffers`.
+void release_phong_mesh(const GlApi &gl, PhongMeshBuffers &buffers);
 
 } // namespace vbrdf

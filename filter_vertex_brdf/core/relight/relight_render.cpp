@@ -37,8 +37,7 @@ const char *const kShadeVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
-layout(location = 3) in vec2 a_ks_alpha;
-layout(location = 4) in float a_coated;
+layout(location = 3) in vec3 a_ks_alpha_coated;  // upload_phong_mesh's layout (location 4 unused)
 uniform mat4 u_view;
 uniform mat4 u_projection;
 out vec3 v_position;
@@ -52,8 +51,8 @@ void main() {
   v_position = a_position;
   v_normal = a_normal;
   v_rho_fitted = a_rho_fitted;
-  v_ks_alpha = a_ks_alpha;
-  v_coated = a_coated;
+  v_ks_alpha = a_ks_alpha_coated.xy;
+  v_coated = a_ks_alpha_coated.z;
   v_depth = -view_pos.z;
   gl_Position = u_projection * view_pos;
 }
@@ -124,8 +123,6 @@ void main() {
 }
 )";
 
-constexpr int kFloatsPerVertex = 13;  // position 3, normal 3, rho 3, fitted 1, k_s 1, alpha 1, coated 1
-
 void normalise(const float in[3], float out[3], const char *what) {
   const double len = std::sqrt(double(in[0]) * in[0] + double(in[1]) * in[1] + double(in[2]) * in[2]);
   if (!(len > 1e-12) || !std::isfinite(len))
@@ -152,11 +149,11 @@ private:
 
   GlApi gl_;
   RelightRenderSettings settings_;
-  size_t index_count_ = 0;
+  PhongMeshBuffers mesh_;
   float origin_[3] = {0, 0, 0};
   float corners_[8][3] = {};
   float radius_ = 0, tolerance_ = 0;
-  GLuint shade_program_ = 0, shadow_program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+  GLuint shade_program_ = 0, shadow_program_ = 0;
   GlRenderTarget camera_target_, shadow_target_;
 };
 
@@ -191,55 +188,22 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
 }
 
 void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
-  const float alpha_default = typical_shininess(fits);
-  std::vector<float> data(mesh.vertex_count * kFloatsPerVertex);
-  for (size_t v = 0; v < mesh.vertex_count; ++v) {
-    float *o = &data[v * kFloatsPerVertex];
-    const VertexFit &f = fits[v];
-    for (int k = 0; k < 3; ++k) {
-      o[k] = mesh.positions[3 * v + k] - origin_[k];
-      o[3 + k] = mesh.normals[3 * v + k];
-      o[6 + k] = f.kd * f.color[k];
-    }
-    o[9] = f.status == kFitNone ? 0.0f : 1.0f;
-    o[10] = f.ks;
-    o[11] = f.ks > 0 && f.shininess > 0 ? f.shininess : alpha_default;
-    o[12] = settings_.diffuse.at(v) == DiffuseForm::Coated ? 1.0f : 0.0f;
-  }
-  index_count_ = mesh.index_count;
-
-  gl_.GenVertexArrays(1, &vao_);
-  gl_.BindVertexArray(vao_);
-  gl_.GenBuffers(1, &vbo_);
-  gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
-  gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
-  const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  const int sizes[5] = {3, 3, 4, 2, 1}, offsets[5] = {0, 3, 6, 10, 12};
-  for (GLuint a = 0; a < 5; ++a) {
-    gl_.VertexAttribPointer(a, sizes[a], GL_FLOAT, GL_FALSE, stride,
-                            reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
-    gl_.EnableVertexAttribArray(a);
-  }
-  gl_.GenBuffers(1, &ibo_);
-  gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);  // recorded in our VAO only
-  gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.index_count * sizeof(uint32_t)), mesh.indices,
-                 GL_STATIC_DRAW);
+  const double origin[3] = {origin_[0], origin_[1], origin_[2]};
+  mesh_ = upload_phong_mesh(gl_, mesh, origin, fits, settings_.diffuse);
 }
 
 void RelightRenderer::Impl::release() {
   release_render_target(gl_, camera_target_);
   release_render_target(gl_, shadow_target_);
-  if (vao_) gl_.DeleteVertexArrays(1, &vao_);
-  if (vbo_) gl_.DeleteBuffers(1, &vbo_);
-  if (ibo_) gl_.DeleteBuffers(1, &ibo_);
+  release_phong_mesh(gl_, mesh_);
   if (shade_program_) gl_.DeleteProgram(shade_program_);
   if (shadow_program_) gl_.DeleteProgram(shadow_program_);
-  vao_ = vbo_ = ibo_ = shade_program_ = shadow_program_ = 0;
+  shade_program_ = shadow_program_ = 0;
 }
 
 void RelightRenderer::Impl::draw() {
-  gl_.BindVertexArray(vao_);
-  if (index_count_ > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(index_count_), GL_UNSIGNED_INT, nullptr);
+  gl_.BindVertexArray(mesh_.vao);
+  if (mesh_.index_count > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(mesh_.index_count), GL_UNSIGNED_INT, nullptr);
 }
 
 // The light's view (light_view.h, shared with the visibility pass).
