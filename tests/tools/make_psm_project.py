@@ -7,7 +7,12 @@ light directions in lights.txt), so that the plugin can fit it and vbrdf_eval ca
                         [--camera-distance D]
 
 DATA_DIR holds lights.txt and OBJECT/OBJECT.{0..11}.tga + OBJECT.mask.tga (e.g.
-../shared/real/psm_uw_seitz). Written to OUT_DIR:
+../shared/real/psm_uw_seitz), or it is the Harvard set (Xiong et al., e.g.
+../shared/real/harvard_psdata): OBJECT/Objects/Image_01..20.png (8-bit grey), the light directions
+OBJECT/light_directions.txt (3 rows of n: x, y, z in the .lp's camera frame, as the repository's
+lights tool test checks against the set's mirror spheres) and the mask
+third_party_masks_hjl18/OBJECT_mask.png. Which one is told by lights.txt in DATA_DIR. Written to
+OUT_DIR:
     mesh.ply          binary PLY: one vertex per mask pixel (x y z nx ny nz), two triangles per
                       2x2 block of mask pixels; normals = the photometric-stereo normals
     project.mlp       the mesh + one raster per training photo, all with the same camera
@@ -110,6 +115,104 @@ def read_tga(path):
     if not desc & 0x20:     # bottom-left origin: first stored row is the bottom one
         rgb = rgb[::-1]
     return np.ascontiguousarray(rgb)
+
+
+def read_png(path):
+    """8/16-bit grey, grey+alpha, RGB or RGBA PNG (non-interlaced) -> uint8/uint16 array (H, W, C),
+    with the standard library's zlib and numpy only (unfiltering: Sub and Up vectorised, Average
+    and Paeth per pixel)."""
+    with open(path, 'rb') as f:
+        data = f.read()
+    if data[:8] != b'\x89PNG\r\n\x1a\n':
+        raise InputError('%s: not a PNG file' % path)
+    pos, idat, header = 8, [], None
+    while pos + 8 <= len(data):
+        length, kind = struct.unpack_from('>I4s', data, pos)
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b'IHDR':
+            header = struct.unpack('>IIBBBBB', body)
+        elif kind == b'IDAT':
+            idat.append(body)
+        elif kind == b'IEND':
+            break
+        pos += 12 + length
+    if header is None:
+        raise InputError('%s: no IHDR' % path)
+    width, height, depth, colour, _, _, interlace = header
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}.get(colour)
+    if channels is None or depth not in (8, 16) or interlace:
+        raise InputError('%s: only non-interlaced 8/16-bit grey or RGB(A) PNG is supported' % path)
+    bpp = channels * depth // 8
+    stride = width * bpp
+    raw = np.frombuffer(zlib.decompress(b''.join(idat)), np.uint8).reshape(height, stride + 1)
+    out = np.zeros((height, stride), np.uint8)
+    prior = np.zeros(stride, np.int32)
+    for r in range(height):
+        kind, line = raw[r, 0], raw[r, 1:].astype(np.int32)
+        if kind == 0:
+            rec = line
+        elif kind == 1:
+            rec = np.cumsum(line.reshape(width, bpp), axis=0).reshape(stride) % 256
+        elif kind == 2:
+            rec = (line + prior) % 256
+        elif kind in (3, 4):
+            rec = np.zeros(stride, np.int32)
+            for i in range(0, stride, bpp):
+                left = rec[i - bpp:i] if i else np.zeros(bpp, np.int32)
+                up = prior[i:i + bpp]
+                if kind == 3:
+                    pred = (left + up) // 2
+                else:
+                    upleft = prior[i - bpp:i] if i else np.zeros(bpp, np.int32)
+                    p = left + up - upleft
+                    pa, pb, pc = np.abs(p - left), np.abs(p - up), np.abs(p - upleft)
+                    pred = np.where((pa <= pb) & (pa <= pc), left, np.where(pb <= pc, up, upleft))
+                rec[i:i + bpp] = (line[i:i + bpp] + pred) % 256
+        else:
+            raise InputError('%s: unknown PNG filter %d' % (path, kind))
+        out[r] = rec
+        prior = rec
+    if depth == 16:
+        return (out.reshape(height, width * channels, 2).astype(np.uint16) * np.array([256, 1], np.uint16)).sum(
+            axis=2, dtype=np.uint16).reshape(height, width, channels)
+    return out.reshape(height, width, channels)
+
+
+def load_seitz(data_dir, name):
+    """Photos (H, W, 3) uint8, mask (H, W) bool and unit light directions (n, 3) of a Seitz object."""
+    lights = read_lights(os.path.join(data_dir, 'lights.txt'))
+    obj_dir = os.path.join(data_dir, name)
+    if not os.path.isdir(obj_dir):
+        raise InputError('%s: no such object folder' % obj_dir)
+    photos = [read_tga(os.path.join(obj_dir, '%s.%d.tga' % (name, k))) for k in range(len(lights))]
+    mask_img = read_tga(os.path.join(obj_dir, '%s.mask.tga' % name))
+    if mask_img.shape != photos[0].shape:
+        raise InputError('%s: photos and mask differ in size' % obj_dir)
+    return photos, mask_img.max(axis=2) > 127, lights
+
+
+def load_harvard(data_dir, name):
+    """The same for an object of the Harvard set (grey photos replicated to RGB)."""
+    obj_dir = os.path.join(data_dir, name)
+    path = os.path.join(obj_dir, 'light_directions.txt')
+    if not os.path.isfile(path):
+        raise InputError('%s: no such file (Harvard object folder expected)' % path)
+    with open(path) as f:
+        values = np.array([float(t) for t in f.read().split()])
+    if values.size % 3 or values.size == 0:
+        raise InputError('%s: expected 3 rows of n directions' % path)
+    lights = values.reshape(3, -1).T
+    lights = lights / np.linalg.norm(lights, axis=1)[:, None]
+    photos = []
+    for k in range(len(lights)):
+        img = read_png(os.path.join(obj_dir, 'Objects', 'Image_%02d.png' % (k + 1)))
+        if img.dtype != np.uint8:
+            raise InputError('%s: 8-bit photos expected' % obj_dir)
+        photos.append(np.ascontiguousarray(np.repeat(img[:, :, :1], 3, axis=2) if img.shape[2] < 3 else img[:, :, :3]))
+    mask_img = read_png(os.path.join(data_dir, 'third_party_masks_hjl18', '%s_mask.png' % name))
+    if mask_img.shape[:2] != photos[0].shape[:2]:
+        raise InputError('%s: photos and mask differ in size' % obj_dir)
+    return photos, mask_img[:, :, 0] > 127, lights
 
 
 def read_lights(path):
@@ -396,17 +499,20 @@ def grey_sphere_exponent(data_dir, photos_as='linear', min_ndl=0.2):
     return float(np.linalg.lstsq(design, y, rcond=None)[0][1])
 
 
+def is_seitz_set(data_dir):
+    return os.path.isfile(os.path.join(data_dir, 'lights.txt'))
+
+
+def load_object(data_dir, name):
+    """Photos, mask and light directions of OBJECT in either set (the module docstring)."""
+    return (load_seitz if is_seitz_set(data_dir) else load_harvard)(data_dir, name)
+
+
 def build(data_dir, name, out_dir, heldout=None, distance=1e5, photos_as='linear', log=print):
-    lights_all = read_lights(os.path.join(data_dir, 'lights.txt'))
-    obj_dir = os.path.join(data_dir, name)
-    if not os.path.isdir(obj_dir):
-        raise InputError('%s: no such object folder' % obj_dir)
-    photos = [read_tga(os.path.join(obj_dir, '%s.%d.tga' % (name, k))) for k in range(len(lights_all))]
-    mask_img = read_tga(os.path.join(obj_dir, '%s.mask.tga' % name))
+    photos, mask, lights_all = load_object(data_dir, name)
     height, width, _ = photos[0].shape
-    if any(p.shape != photos[0].shape for p in photos) or mask_img.shape != photos[0].shape:
-        raise InputError('%s: photos and mask differ in size' % obj_dir)
-    mask = mask_img.max(axis=2) > 127
+    if any(p.shape != photos[0].shape for p in photos):
+        raise InputError('%s: the photos differ in size' % os.path.join(data_dir, name))
 
     if heldout is None:
         heldout = default_heldout(lights_all)

@@ -1,13 +1,14 @@
 #!/usr/bin/python3
 """ctest driver (psm_real_projects): builds registered projects from the real photometric-stereo
-set (make_psm_project.py) into a work folder, fits them with vbrdf_fit (defaults) and scores
-them with vbrdf_eval on the held-out lights.
+sets (make_psm_project.py: the Seitz set, or the Harvard set when --data is harvard_psdata) into
+a work folder, fits them with vbrdf_fit (defaults) and scores them with vbrdf_eval on the held-out
+lights.
 
     run_psm_real.py --data DIR --workdir DIR --fit-tool vbrdf_fit --eval-tool vbrdf_eval
                     [--objects owl cat] [--photos linear|srgb] [--fit-options "--lobe re"]
 
 Checks (each can fail):
-  * the set's decoding: on the matte grey sphere, grey ~ (N.L)^g with |g - 1| < 0.25 for the
+  * the set's decoding (Seitz set only: the Harvard set has no grey sphere): on the matte grey sphere, grey ~ (N.L)^g with |g - 1| < 0.25 for the
     chosen --photos decoding (a wrong decoding gives g of about 2);
   * registration, independently of the builder's own check: every vertex of mesh.ply, projected
     with the camera of project.mlp (MeshLab's formula), lands within 0.01 px of a pixel centre,
@@ -92,10 +93,10 @@ def sampling_check(args, name, fit, mask):
     """Correlation of the fit's diffuse colour with the photometric-stereo albedo at the vertex's
     pixel and at the four 1-px shifts; returns a list of failures."""
     rows, cols = np.nonzero(mask)   # the builder's vertex order
-    lights = psm.read_lights(os.path.join(args.data, 'lights.txt'))
+    all_photos, _, lights = psm.load_object(args.data, name)
     with open(os.path.join(args.workdir, name, 'psm_project.json')) as f:
         train = json.load(f)['train_lights']
-    photos = np.stack([psm.read_tga(os.path.join(args.data, name, '%s.%d.tga' % (name, k))) for k in train])
+    photos = np.stack([all_photos[k] for k in train])
     fitted = fit['fit_status'] > 0
     diffuse = (fit['diffuse_r'] + fit['diffuse_g'] + fit['diffuse_b'])[fitted]
     corr = {}
@@ -129,7 +130,7 @@ def check_object(args, name):
         psm.build(args.data, name, out, photos_as=args.photos, log=lambda s: print('  ' + s))
     except psm.RegistrationError as e:
         return ['%s: builder: %s' % (name, e)]
-    mask = psm.read_tga(os.path.join(args.data, name, '%s.mask.tga' % name)).max(axis=2) > 127
+    _, mask, _ = psm.load_object(args.data, name)
     failures += ['%s: %s' % (name, f) for f in check_registration(out, mask)]
 
     fit_ply = os.path.join(out, 'fit.ply')
@@ -193,15 +194,19 @@ def main():
     ap.add_argument('--photos', choices=('linear', 'srgb'), default='linear')
     ap.add_argument('--fit-options', default='', help='extra vbrdf_fit options, e.g. "--lobe re"')
     args = ap.parse_args()
-    if not os.path.isfile(os.path.join(args.data, 'lights.txt')):
+    seitz = psm.is_seitz_set(args.data)
+    if not seitz and not all(os.path.isfile(os.path.join(args.data, o, 'light_directions.txt')) for o in args.objects):
         print('SKIP: real photometric-stereo set not found at %s (see the README: it lives in '
               '../shared beside the repository and is not part of it)' % args.data)
         return SKIP
     failures = []
-    exponent = psm.grey_sphere_exponent(args.data, args.photos)
-    print('grey sphere: grey ~ (N.L)^%.3f with the photos decoded as %s' % (exponent, args.photos))
-    if abs(exponent - 1.0) >= 0.25:
-        failures.append('grey sphere exponent %.3f: decoding %s is not linear in radiance' % (exponent, args.photos))
+    if seitz:
+        exponent = psm.grey_sphere_exponent(args.data, args.photos)
+        print('grey sphere: grey ~ (N.L)^%.3f with the photos decoded as %s' % (exponent, args.photos))
+        if abs(exponent - 1.0) >= 0.25:
+            failures.append('grey sphere exponent %.3f: decoding %s is not linear in radiance' % (exponent, args.photos))
+    else:
+        print('Harvard set: no grey sphere to check the decoding (%s as asked)' % args.photos)
     os.makedirs(args.workdir, exist_ok=True)
     for name in args.objects:
         print('== %s' % name)
