@@ -84,7 +84,7 @@ def import_mlx(path, values):
   <Param name="sphereCenterX" type="RichFloat" value="{p['sphereCenterX']}"/>
   <Param name="sphereCenterY" type="RichFloat" value="{p['sphereCenterY']}"/>
   <Param name="sphereRadius" type="RichFloat" value="{p['sphereRadius']}"/>
-  <Param name="outputLightFile" type="RichSaveFile" value="{p['outputLightFile']}" ext="Light positions (*.lp)"/>
+  <Param name="outputLightFile" type="RichString" value="{p['outputLightFile']}"/>
   <Param name="updateCoverage" type="RichBool" value="{p['updateCoverage']}"/>
  </filter>
 </FilterScript>
