@@ -25,6 +25,9 @@
 // own surface, the model rendered with 4x4 subpixels where it covers background or another surface
 // (silhouettes, contacts); vertex: the vertex's model alone (ignores what else the footprint covers).
 // --gt-lit: ground-truth lit flags per held-out light (load_lit below) instead of our shadow passes.
+// --samples-csv FILE: every scored sample (vertex, held-out photo, fit_status, mixed footprint, diffuse
+//   factor, observed and predicted linear RGB, CIEDE2000 of the product, PTM and RBF: -1 where not
+//   scored), to locate the error (e.g. tests/tools/error_map.py).
 // --gt-visible: score only vertices whose uchar `visible` property (ground-truth PLY, same vertex
 //   order as the result) is non-zero.
 // --max-mean-de / --max-p95-de: bounds on the whole-surface product figure.
@@ -55,6 +58,21 @@
 using namespace vbrdf;
 
 namespace {
+void write_samples_csv(const std::string &path, const std::vector<ScoredSample> &samples,
+                       const std::vector<Raster> &rasters) {
+  std::ofstream out(path);
+  if (!out) throw InputError("--samples-csv: cannot write '" + path + "'.");
+  out << "vertex,photo,fit_status,mixed,d,obs_r,obs_g,obs_b,pred_r,pred_g,pred_b,de,de_ptm,de_rbf\n";
+  for (const ScoredSample &s : samples) {
+    out << s.vertex << ',' << rasters[s.raster].label << ',' << int(s.fit_status) << ',' << int(s.mixed) << ','
+        << s.d;
+    for (float v : s.observed) out << ',' << v;
+    for (float v : s.predicted) out << ',' << v;
+    out << ',' << s.de << ',' << s.de_ptm << ',' << s.de_rbf << '\n';
+  }
+  if (!out) throw InputError("--samples-csv: writing '" + path + "' failed.");
+}
+
 struct Photos {
   Project project;
   std::vector<LightSource> lights;
@@ -117,7 +135,7 @@ void row(const char *name, const ErrorSummary &s) {
 
 int main(int argc, char **argv) {
   std::string result_path, mlp, lp, photo_dir, backend = "gl", train_mlp, train_lp, train_photo_dir, gt_path,
-      gt_lit_path, predict = "render";
+      gt_lit_path, predict = "render", samples_csv;
   double max_mean = -1, max_p95 = -1, max_clean_mean = -1, max_clean_p95 = -1;
   float dome_radius = 0, light_unit_scale = 0;
   bool below_baselines = false;
@@ -144,6 +162,7 @@ int main(int argc, char **argv) {
     else if (a == "--training-photo-dir") train_photo_dir = v;
     else if (a == "--gt-visible") gt_path = v;
     else if (a == "--gt-lit") gt_lit_path = v;
+    else if (a == "--samples-csv") samples_csv = v;
     else if (a == "--predict") predict = v;
     else if (a == "--max-mean-de") max_mean = std::stod(v);
     else if (a == "--max-p95-de") max_p95 = std::stod(v);
@@ -214,10 +233,13 @@ int main(int argc, char **argv) {
     } else if (predict != "vertex") {
       throw InputError("--predict takes 'render' or 'vertex'");
     }
+    std::vector<ScoredSample> per_sample;
+    if (!samples_csv.empty()) options.per_sample = &per_sample;
     const RelightStats s =
         evaluate_relighting(result.mesh.view(), fits, heldout.project.rasters, heldout.lights, *visibility, options);
 
     const auto &rasters = heldout.project.rasters;
+    if (!samples_csv.empty()) write_samples_csv(samples_csv, per_sample, rasters);
     std::printf("relit on %zu held-out photos%s; scored vertices: %s; lit as %s says\n", rasters.size(),
                 s.has_baselines ? ", baselines from the training photos of the same camera" : "",
                 gt_path.empty() ? "all" : "ground-truth visible",

@@ -63,7 +63,7 @@ def read_ply_vertices(path):
 
 def check_registration(out_dir, mask):
     """Independent re-projection of mesh.ply through project.mlp; returns a list of failures."""
-    vert = read_ply_vertices(os.path.join(out_dir, 'mesh.ply'))
+    vert = read_ply_vertices(os.path.join(out_dir, 'mesh.ply'))[:int(mask.sum())]  # the skirt follows
     cam = psm.parse_camera(os.path.join(out_dir, 'project.mlp'))
     rot = cam['RotationMatrix'].reshape(4, 4)[:3, :3]
     pos = np.stack([vert['x'], vert['y'], vert['z']], 1).astype(np.float64)
@@ -97,6 +97,7 @@ def sampling_check(args, name, fit, mask):
     with open(os.path.join(args.workdir, name, 'psm_project.json')) as f:
         train = json.load(f)['train_lights']
     photos = np.stack([all_photos[k] for k in train])
+    fit = fit[:len(rows)]  # the object's vertices; the skirt follows
     fitted = fit['fit_status'] > 0
     diffuse = (fit['diffuse_r'] + fit['diffuse_g'] + fit['diffuse_b'])[fitted]
     corr = {}
@@ -159,7 +160,8 @@ def check_object(args, name):
     # the product below per-pixel PTM and RBF fitted on the same training photos, in mean and p95,
     # and no seen vertex without a model.
     rc, text = run([args.eval_tool, '--result', fit_ply, '--project', os.path.join(out, 'heldout', 'project.mlp'),
-                    '--training', os.path.join(out, 'project.mlp'), '--below-baselines'])
+                    '--training', os.path.join(out, 'project.mlp'), '--below-baselines',
+                    '--gt-visible', os.path.join(out, 'object_pixels.ply')])
     print('\n'.join('   ' + l for l in text.splitlines()))
     rows = {}
     for label, key in (('whole surface: product', 'product'), ('same samples: PTM', 'ptm'),

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+
+#include <omp.h>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/mcc.hpp>
@@ -229,16 +232,39 @@ bool locate_chart(size_t count, const RgbLoader &load, const ColorSettings &s, c
   std::vector<ChartLocation> best;
   size_t best_photo = 0;
   std::vector<std::string> det_log;
-  for (size_t t = 0; t < tries; ++t) {
-    const size_t i = tries > 1 ? t * (count - 1) / (tries - 1) : 0;
-    const cv::Mat img = load(i);
-    if (img.empty()) continue;
-    std::vector<std::string> lines;
-    const std::vector<ChartLocation> found = detect_charts(srgb8_bgr_image(img), 2, lines);
-    if (!found.empty() && (best.empty() || found[0].cost < best[0].cost)) {
-      best = found;
-      best_photo = i;
-      det_log = lines;
+  // The detector runs on one core; the photos it tries are searched side by side, as many at a
+  // time as there are threads (their 8-bit copies are held that long), in a fixed order so that
+  // the choice below does not depend on the timing.
+  const size_t batch = size_t(std::max(1, omp_get_max_threads()));
+  for (size_t first = 0; first < tries; first += batch) {
+    const size_t n = std::min(batch, tries - first);
+    std::vector<size_t> photo(n);
+    std::vector<cv::Mat> bgr(n);
+    for (size_t b = 0; b < n; ++b) {  // the loader is not assumed to be thread-safe
+      const size_t t = first + b;
+      photo[b] = tries > 1 ? t * (count - 1) / (tries - 1) : 0;
+      const cv::Mat img = load(photo[b]);
+      if (!img.empty()) bgr[b] = srgb8_bgr_image(img);
+    }
+    std::vector<std::vector<ChartLocation>> found(n);
+    std::vector<std::vector<std::string>> lines(n);
+    std::vector<std::exception_ptr> failure(n);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long long b = 0; b < (long long)n; ++b) {
+      if (bgr[size_t(b)].empty()) continue;
+      try {
+        found[size_t(b)] = detect_charts(bgr[size_t(b)], 2, lines[size_t(b)]);
+      } catch (...) {
+        failure[size_t(b)] = std::current_exception();
+      }
+    }
+    for (size_t b = 0; b < n; ++b) {
+      if (failure[b]) std::rethrow_exception(failure[b]);
+      if (!found[b].empty() && (best.empty() || found[b][0].cost < best[0].cost)) {
+        best = found[b];
+        best_photo = photo[b];
+        det_log = lines[b];
+      }
     }
   }
   if (best.empty()) return false;

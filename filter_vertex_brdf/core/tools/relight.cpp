@@ -113,6 +113,7 @@ void fit_vertex_baseline(const BaselinePlan &plan, int viewpoint, const Sample *
 
 // One scored held-out sample.
 struct Scored {
+  ScoredSample sample;
   float de, de_ptm, de_rbf;
   float squared_error;  // over the 3 channels, prediction clamped to 1
   uint16_t raster;
@@ -242,6 +243,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
           predict_footprint((*options.rendered)[s.raster], ip.x, ip.y, own, at_vertex, predicted);
         }
         r.de = float(delta_e2000_linear_srgb(predicted, s.rgb));
+        r.de_ptm = r.de_rbf = -1.0f;
         for (int c = 0; c < 3; ++c) {
           const float e = std::min(predicted[c], 1.0f) - s.rgb[c];
           r.squared_error += e * e;
@@ -262,6 +264,16 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
             r.has_baseline = true;
           }
         }
+        if (options.per_sample) {
+          ScoredSample &o = r.sample;
+          o.vertex = uint32_t(v);
+          o.raster = s.raster;
+          o.fit_status = fit.status;
+          o.mixed = r.mixed;
+          o.d = s.d;
+          for (int c = 0; c < 3; ++c) o.observed[c] = s.rgb[c], o.predicted[c] = predicted[c];
+          o.de = r.de, o.de_ptm = r.de_ptm, o.de_rbf = r.de_rbf;
+        }
         scored[i].push_back(r);
       }
     }
@@ -272,6 +284,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         if (!modelled) ++stats.seen_unmodelled_vertices;
       }
       for (const Scored &r : scored[i]) {
+        if (options.per_sample) options.per_sample->push_back(r.sample);
         de_all.push_back(r.de);
         squared_error += r.squared_error;
         stats.per_raster_mean_de2000[r.raster] += r.de;

@@ -51,6 +51,21 @@ struct RelightOptions {
   const std::vector<Raster> *training_rasters = nullptr;
   const std::vector<LightSource> *training_lights = nullptr;
   float rbf_ridge = 1e-3f;
+  // Optional (null = not kept): every scored sample, appended in vertex order (for tools that
+  // locate the error: vbrdf_eval --samples-csv).
+  std::vector<struct ScoredSample> *per_sample = nullptr;
+};
+
+// One scored held-out sample, as RelightOptions::per_sample keeps it. de_ptm / de_rbf are -1
+// where the baselines did not score it.
+struct ScoredSample {
+  uint32_t vertex;
+  uint16_t raster;
+  uint8_t fit_status;
+  bool mixed;
+  float d;                    // the diffuse factor (N.L for Lambert)
+  float observed[3], predicted[3];
+  float de, de_ptm, de_rbf;
 };
 
 struct RelightStats {
