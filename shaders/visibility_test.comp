@@ -27,13 +27,21 @@ uniform float u_tolerance;       // depth tolerance, world units
 uniform float u_slack_per_depth; // camera pass: own_surface_depth_slack = tolerance + this * depth
 uniform float u_light_scale;     // light pass: window mapping of light_view.h
 uniform int u_perspective;       // light pass: 1 for a point light (w = depth)
-uniform sampler2D u_depth;       // R32F linear depth, GL rows (row 0 = bottom of the image)
+uniform sampler2D u_depth;       // R32F linear depth, GL rows (row 0 = bottom of the image), or:
+uniform int u_window_depth;      // 1: u_depth is a depth texture of window depth (light pass, orthographic)
+uniform vec4 u_unproject;        // then: P[2][2], P[3][2], P[2][3], P[3][3] of u_projection (gl_depth.h)
 uniform int u_divisor;           // camera pass: photo pixels per map texel, per axis
 uniform int u_photo_width, u_photo_height;  // camera pass: photo size in pixels
 
 ivec2 map_size() { return ivec2(u_width, u_height); }
 
-float texel(int x, int y) { return texelFetch(u_depth, ivec2(x, y), 0).r; }
+// The view depth at texel (x, y): gl_depth.cpp's linear_depth_from_window for window depth.
+float texel(int x, int y) {
+  float t = texelFetch(u_depth, ivec2(x, y), 0).r;
+  if (u_window_depth == 0) return t;
+  float ndc = 2.0 * t - 1.0;
+  return -(u_unproject.y - ndc * u_unproject.w) / (ndc * u_unproject.z - u_unproject.x);
+}
 
 // depth is at most the tolerance behind the farthest of the 2x2 texels nearest to window point w.
 bool depth_clear(vec2 w, float depth) {

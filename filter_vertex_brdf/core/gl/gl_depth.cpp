@@ -27,6 +27,10 @@ layout(location = 0) out float o_depth;
 void main() { o_depth = v_depth; }
 )";
 
+const char *const kDepthOnlyFragmentShader = R"(#version 330 core
+void main() {}
+)";
+
 GlMeshFrame gl_mesh_frame(const MeshView &mesh, float depth_tolerance_fraction, const std::string &who) {
   if (mesh.index_count > size_t(INT_MAX))
     throw ProcessingError(who + ": the mesh has " + std::to_string(mesh.index_count / 3) +
@@ -70,10 +74,54 @@ void check_gl_target_size(const GlApi &gl, int width, int height, const std::str
                           ". Use smaller photos or shadow map, or the CPU back end.");
 }
 
+namespace {
+void ensure_window_depth_target(const GlApi &gl, GlRenderTarget &t, int width, int height, const std::string &what) {
+  if (!t.fbo) {
+    gl.GenFramebuffers(1, &t.fbo);
+    gl.GenTextures(1, &t.color);
+  }
+  gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
+  gl.BindTexture(GL_TEXTURE_2D, t.color);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);  // texelFetch reads the depth itself
+  gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, t.color, 0);
+  const GLenum none = GL_NONE;
+  gl.DrawBuffers(1, &none);
+  gl.ReadBuffer(GL_NONE);
+  check_gl_error(gl, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
+                         " depth target for " + what);
+  check_framebuffer(gl, GL_FRAMEBUFFER, what);
+  t.width = width;
+  t.height = height;
+}
+} // namespace
+
+float linear_depth_from_window(const float projection[16], float window) {
+  float u[4];
+  window_depth_unproject(projection, u);
+  const float ndc = 2.0f * window - 1.0f;
+  return -(u[1] - ndc * u[3]) / (ndc * u[2] - u[0]);
+}
+
+void window_depth_unproject(const float projection[16], float out[4]) {
+  out[0] = projection[10];  // P[2][2]: column 2, row 2
+  out[1] = projection[14];  // P[3][2]: column 3, row 2
+  out[2] = projection[11];  // P[2][3]: column 2, row 3
+  out[3] = projection[15];  // P[3][3]
+}
+
 void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
                           const std::string &who, const std::string &what) {
   if (t.fbo && t.width == width && t.height == height) return;
   check_gl_target_size(gl, width, height, who, what);
+  if (kind == RenderTargetKind::WindowDepth) {
+    ensure_window_depth_target(gl, t, width, height, what);
+    return;
+  }
   const bool shading = kind == RenderTargetKind::ShadingAndDepth;
   if (!t.fbo) {
     gl.GenFramebuffers(1, &t.fbo);

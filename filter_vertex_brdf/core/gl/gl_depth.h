@@ -14,6 +14,7 @@ struct GlApi;
 
 extern const char *const kLinearDepthVertexShader;    // a_position (location 0), u_view, u_projection
 extern const char *const kLinearDepthFragmentShader;  // one float output: the linear depth
+extern const char *const kDepthOnlyFragmentShader;    // no output: the window depth alone
 
 // Column-major 4x4 matrix, as GL takes it.
 struct Mat4 {
@@ -38,12 +39,23 @@ GlMeshFrame gl_mesh_frame(const MeshView &mesh, float depth_tolerance_fraction, 
 
 // An FBO with float colour outputs and a 32F depth renderbuffer. Attachment 0 is R32F for a depth
 // pass (the linear depth) or RGBA32F for a shading pass, whose attachment 1 (`extra`) is then an
-// R32F linear depth. Names are GL object names (GLuint); 0 = not allocated.
+// R32F linear depth. WindowDepth has no colour output: `color` is then a 32F depth *texture* (the
+// rasteriser's window depth, which the caller converts: linear_depth_from_window) and `depth` is 0;
+// without a fragment shader's output a software rasteriser writes half the bytes per pixel.
+// Names are GL object names (GLuint); 0 = not allocated.
 struct GlRenderTarget {
   unsigned fbo = 0, color = 0, extra = 0, depth = 0;
   int width = 0, height = 0;
 };
-enum class RenderTargetKind { LinearDepth, ShadingAndDepth };
+enum class RenderTargetKind { LinearDepth, ShadingAndDepth, WindowDepth };
+
+// The depth along the view axis (-z in view space) of a fragment whose window depth (glDepthRange
+// 0..1) is `window`, under the projection matrix `projection` (column-major, as GL takes it): from
+// z_ndc = (P[2][2] z + P[3][2]) / (P[2][3] z + P[3][3]), exact for orthographic and perspective
+// projections. The GLSL of visibility_test.comp does the same with window_depth_unproject().
+float linear_depth_from_window(const float projection[16], float window);
+// The four entries of `projection` that function uses: P[2][2], P[3][2], P[2][3], P[3][3].
+void window_depth_unproject(const float projection[16], float out[4]);
 
 // (Re)allocates `t` at width x height unless it already has that size, after
 // check_gl_target_size; leaves it bound as the framebuffer with its colour outputs as draw buffers.

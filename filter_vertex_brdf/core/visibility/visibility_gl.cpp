@@ -93,7 +93,8 @@ public:
 private:
   void upload_mesh();
   void release_gl();
-  void render_depth(const GlRenderTarget &target, const Mat4 &view, const Mat4 &projection, const std::string &what);
+  void render_depth(const GlRenderTarget &target, const Mat4 &view, const Mat4 &projection, const std::string &what,
+                    bool depth_only = false);
   void read_depth(const GlRenderTarget &target, const std::string &what);
   void build_test_program();
   struct TestPass {  // the uniforms of one dispatch of shaders/visibility_test.comp
@@ -103,6 +104,7 @@ private:
     int divisor = 1, photo_width = 0, photo_height = 0;  // camera pass: map texel = divisor^2 photo pixels
     float light_scale = 1;      // light pass
     bool perspective = false;   // light pass
+    bool window_depth = false;  // the map holds window depth (RenderTargetKind::WindowDepth)
   };
   void test_on_gpu(const GlRenderTarget &target, const TestPass &pass, uint8_t *out, const std::string &what);
   void fill(uint8_t *out, uint8_t value) const;
@@ -116,12 +118,16 @@ private:
   float tolerance_ = 0;          // settings.depth_tolerance * bbox diagonal (world units)
   GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
   GLint u_view_ = -1, u_projection_ = -1;
-  GlRenderTarget camera_target_, light_target_;
+  // Directional lights with the GPU tests: a depth-only pass (no fragment output; the tests read
+  // the window depth and unproject it), which a software rasteriser fills in about half the time.
+  GLuint depth_only_program_ = 0;
+  GLint d_view_ = -1, d_projection_ = -1;
+  GlRenderTarget camera_target_, light_target_, light_window_target_;
   GLuint test_program_ = 0, codes_ = 0;  // compute-shader tests; 0 when they are off or unsupported
   struct TestUniforms {
     GLint vertex_count = -1, first_word = -1, light_pass = -1, view = -1, projection = -1, width = -1, height = -1;
     GLint tolerance = -1, slack_per_depth = -1, light_scale = -1, perspective = -1, depth = -1;
-    GLint divisor = -1, photo_width = -1, photo_height = -1;
+    GLint divisor = -1, photo_width = -1, photo_height = -1, window_depth = -1, unproject = -1;
   } tu_;
   GLsizeiptr codes_bytes_ = 0;
   std::vector<float> depth_;     // read-back buffer, reused between passes
@@ -164,6 +170,9 @@ GlVisibility::~GlVisibility() { release_gl(); }
 void GlVisibility::release_gl() {
   release_render_target(gl_, camera_target_);
   release_render_target(gl_, light_target_);
+  release_render_target(gl_, light_window_target_);
+  if (depth_only_program_) gl_.DeleteProgram(depth_only_program_);
+  depth_only_program_ = 0;
   if (vao_) gl_.DeleteVertexArrays(1, &vao_);
   if (vbo_) gl_.DeleteBuffers(1, &vbo_);
   if (ibo_) gl_.DeleteBuffers(1, &ibo_);
@@ -196,18 +205,18 @@ void GlVisibility::upload_mesh() {
 
 // Renders the nearest linear depth into `t`. The caller holds a GlStateGuard.
 void GlVisibility::render_depth(const GlRenderTarget &t, const Mat4 &view, const Mat4 &projection,
-                                const std::string &what) {
+                                const std::string &what, bool depth_only) {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl_.Viewport(0, 0, t.width, t.height);
   set_plain_raster_state(gl_);
   gl_.Enable(GL_DEPTH_TEST);
   const float clear_color[4] = {kFarAway, kFarAway, kFarAway, kFarAway}, clear_depth = 1.0f;
-  gl_.ClearBufferfv(GL_COLOR, 0, clear_color);
+  if (!depth_only) gl_.ClearBufferfv(GL_COLOR, 0, clear_color);
   gl_.ClearBufferfv(GL_DEPTH, 0, &clear_depth);
 
-  gl_.UseProgram(program_);
-  gl_.UniformMatrix4fv(u_view_, 1, GL_FALSE, view.m);
-  gl_.UniformMatrix4fv(u_projection_, 1, GL_FALSE, projection.m);
+  gl_.UseProgram(depth_only ? depth_only_program_ : program_);
+  gl_.UniformMatrix4fv(depth_only ? d_view_ : u_view_, 1, GL_FALSE, view.m);
+  gl_.UniformMatrix4fv(depth_only ? d_projection_ : u_projection_, 1, GL_FALSE, projection.m);
   gl_.BindVertexArray(vao_);
   if (mesh_.index_count > 0) gl_.DrawElements(GL_TRIANGLES, GLsizei(mesh_.index_count), GL_UNSIGNED_INT, nullptr);
   check_gl_error(gl_, what);
@@ -242,6 +251,10 @@ void GlVisibility::build_test_program() {
   tu_.tolerance = at("u_tolerance"), tu_.slack_per_depth = at("u_slack_per_depth");
   tu_.light_scale = at("u_light_scale"), tu_.perspective = at("u_perspective"), tu_.depth = at("u_depth");
   tu_.divisor = at("u_divisor"), tu_.photo_width = at("u_photo_width"), tu_.photo_height = at("u_photo_height");
+  tu_.window_depth = at("u_window_depth"), tu_.unproject = at("u_unproject");
+  depth_only_program_ = build_program(gl_, kLinearDepthVertexShader, kDepthOnlyFragmentShader, "the depth-only light pass");
+  d_view_ = gl_.GetUniformLocation(depth_only_program_, "u_view");
+  d_projection_ = gl_.GetUniformLocation(depth_only_program_, "u_projection");
   gl_.GenBuffers(1, &codes_);
 }
 
@@ -271,6 +284,10 @@ void GlVisibility::test_on_gpu(const GlRenderTarget &t, const TestPass &pass, ui
   gl_.Uniform1i(tu_.divisor, pass.divisor);
   gl_.Uniform1i(tu_.photo_width, pass.photo_width);
   gl_.Uniform1i(tu_.photo_height, pass.photo_height);
+  gl_.Uniform1i(tu_.window_depth, pass.window_depth ? 1 : 0);
+  float unproject[4];
+  window_depth_unproject(pass.projection.m, unproject);
+  gl_.Uniform4fv(tu_.unproject, 1, unproject);
   // Texture unit 0 holds the map for the dispatch; the host's binding there is put back after.
   GLint host_unit = GL_TEXTURE0, host_texture = 0;
   gl_.GetIntegerv(GL_ACTIVE_TEXTURE, &host_unit);
@@ -402,6 +419,21 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
   {
     GlStateGuard guard(gl_);
     clear_gl_errors(gl_);
+    // A directional light's orthographic window depth is linear in the view depth and keeps
+    // float precision over the bounding sphere; point lights keep the linear-depth output.
+    if (test_program_ && depth_only_program_ && !lv.perspective) {
+      ensure_render_target(gl_, light_window_target_, size, size, RenderTargetKind::WindowDepth, kWho,
+                           "the light-view shadow map");
+      render_depth(light_window_target_, view, projection, "the light-view shadow map pass", true);
+      TestPass pass;
+      pass.light = true;
+      pass.view = view;
+      pass.projection = projection;
+      pass.light_scale = lv.scale;
+      pass.window_depth = true;
+      test_on_gpu(light_window_target_, pass, out, "the shadow tests");
+      return;
+    }
     ensure_render_target(gl_, light_target_, size, size, RenderTargetKind::LinearDepth, kWho, "the light-view shadow map");
     render_depth(light_target_, view, projection, "the light-view shadow map pass");
     if (test_program_) {
