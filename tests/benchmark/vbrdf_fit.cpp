@@ -3,6 +3,7 @@
 //             [--ts 0.9] [--td 0.2] [--encoding auto|srgb|linear] [--shadow-map 2048] [--depth-tests gpu|cpu]
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
+//             [--photo-shadows on|off]
 //             [--lobe re|nh] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
@@ -31,6 +32,7 @@ int usage() {
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
+               "                 [--photo-shadows on|off]\n"
                "                 [--lobe re|nh] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n";
   return 2;
 }
@@ -57,6 +59,7 @@ int main(int argc, char **argv) {
     else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
     else if (a == "--photo-dir") photo_dir = next();
     else if (a == "--materials") settings.materials = next() == "on";
+    else if (a == "--photo-shadows") settings.photo_shadows.enabled = next() == "on";
     else if (a == "--photo-memory-mb") settings.gather.photo_cache_bytes = size_t(std::stoull(next())) << 20;
     else if (a == "--lobe") {
       if (!parse_lobe_form(next(), settings.phong.lobe)) return usage();

@@ -74,8 +74,8 @@ ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
 
 
 // Everything the chunk consumer produces, per vertex.
-void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options, FitResult &r,
-                   double &fit_seconds) {
+void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options,
+                   const PhotoShadowSettings &photo_shadows, FitResult &r, double &fit_seconds) {
   r.rim_samples_demoted += prefer_clean_samples(chunk);
   estimate_diffuse_chunk(chunk, &r.diffuse[chunk.first_vertex]);
   if (!fitter) return;
@@ -97,6 +97,8 @@ void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOption
     const uint32_t begin = chunk.offsets[size_t(i)], end = chunk.offsets[size_t(i) + 1];
     if (f.status == kFitNone && end > begin) fit_vertex_weak(chunk.samples.data() + begin, end - begin, options, f);
   }
+  refit_photo_shadows(chunk, options, photo_shadows, &r.fits[chunk.first_vertex], r.photo_shadow_samples,
+                      r.photo_shadow_vertices);
   fit_seconds += seconds_since(t);
 }
 
@@ -294,7 +296,8 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
         if (correct) correct_samples(colors, chunk);
         agreement.add(chunk, mesh, lights);
         apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
-        consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, result, result.seconds_fit);
+        consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, settings.photo_shadows, result,
+                      result.seconds_fit);
         if (with_materials) material_samples.add_chunk(chunk, &result.fits[chunk.first_vertex], settings.phong);
       },
       gather_progress);

@@ -16,6 +16,7 @@
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
 #include "fit/materials.h"
+#include "fit/photo_shadows.h"
 #include "base/mesh_view.h"
 #include "io/output_file.h"
 #include "io/output_ply.h"
@@ -80,6 +81,9 @@ struct FitSettings {
   // either fit back end. Keeps the usable samples in memory (28 bytes each) until the stage ran.
   bool materials = false;
   MaterialOptions material_options;
+  // Samples far darker than their vertex's model although the mesh lets the light reach them
+  // (photo_shadows.h): left out, the vertex refitted. On by default; off for comparisons.
+  PhotoShadowSettings photo_shadows;
 };
 
 struct FitInput {
@@ -114,6 +118,7 @@ struct FitResult {
   size_t fit_full = 0, fit_diffuse_only = 0, fit_none = 0, fit_converged = 0, fit_iterations = 0;
   size_t fit_weak = 0, fit_neighbours = 0;  // fit_status 4 and 3
   size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
+  size_t photo_shadow_samples = 0, photo_shadow_vertices = 0;  // photo_shadows.h: flagged, refitted
   NeighbourFillStats fill;
   MaterialResult materials;               // material stage (FitSettings::materials); label empty when off
   DiffuseForms diffuse_forms;             // the forms fitted, per vertex where they vary (FitSettings::diffuse_choice)

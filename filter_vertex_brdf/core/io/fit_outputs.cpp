@@ -163,6 +163,13 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
     rep << "  " << f.second << ": " << g.flag_counts[bit(f.first)] << " (" << percent(g.flag_counts[bit(f.first)], g.pairs) << ")\n";
   rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
   if (settings.fit_reflectance)
+    rep << "  in a shadow the photo shows but the mesh does not cast (darker than "
+        << settings.photo_shadows.darker_than << " x the vertex's model; left out, vertex fitted again): "
+        << (settings.photo_shadows.enabled ? std::to_string(r.photo_shadow_samples) + " samples, " +
+                                                 std::to_string(r.photo_shadow_vertices) + " vertices"
+                                           : std::string("off"))
+        << "\n";
+  if (settings.fit_reflectance)
     rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
         << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
         << "); diffuse term: " << r.diffuse_choice_note << " (per-vertex diffuse_form: 0 lambert, 1 coated)"
