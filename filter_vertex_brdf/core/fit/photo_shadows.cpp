@@ -22,9 +22,10 @@ size_t flag_photo_shadows(const VertexFit &fit, Sample *samples, size_t count, c
     const Sample &s = samples[k];
     if (!usable(s)) continue;
     ++n_usable;
-    float predicted[3];
-    evaluate_phong(fit, s.d, s.lobe_cos, predicted);
-    const float expected = mean_rgb(predicted);
+    // Against the diffuse part alone: a shadow darkens all of a sample, while a sample below an
+    // overshooting lobe is only darker than diffuse + lobe (that is the lobe's misfit, not a shadow).
+    const float diffuse[3] = {fit.kd * fit.color[0] * s.d, fit.kd * fit.color[1] * s.d, fit.kd * fit.color[2] * s.d};
+    const float expected = mean_rgb(diffuse);
     if (expected >= settings.min_predicted && mean_rgb(s.rgb) < settings.darker_than * expected) dark.push_back(k);
   }
   if (dark.empty() || n_usable - dark.size() < kPhotoShadowMinRemaining ||

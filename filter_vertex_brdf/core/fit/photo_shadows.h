@@ -16,14 +16,15 @@ namespace vbrdf {
 
 struct PhotoShadowSettings {
   bool enabled = true;
-  float darker_than = 0.3f;       // observed luminance below this fraction of the model's: a shadow
-  float min_predicted = 0.02f;    // ... where the model predicts at least this (linear, sum of RGB / 3)
+  float darker_than = 0.3f;       // observed below this fraction of the model's diffuse part: a shadow
+  float min_predicted = 0.02f;    // ... where that part is at least this (linear, mean of R, G, B)
   float max_share = 0.5f;         // at most this share of a vertex's usable samples is flagged
 };
 constexpr size_t kPhotoShadowMinRemaining = 3;
 
 // Flags (kCastShadow) the samples of one vertex that `fit` (its model) says should be lit and the
-// photo shows in shadow, under the safeguards above. Usable: not shadowed, saturated or unseen,
+// photo shows in shadow (darker than darker_than x the model's diffuse part k_d C d, so that a lobe
+// that overshoots a sample does not make it a "shadow"), under the safeguards above. Usable: not shadowed, saturated or unseen,
 // diffuse factor d > 0, finite. Returns how many were flagged; 0 leaves the samples as they were.
 size_t flag_photo_shadows(const VertexFit &fit, Sample *samples, size_t count, const PhotoShadowSettings &settings);
 
