@@ -119,7 +119,7 @@ private:
   GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
   GLint u_view_ = -1, u_projection_ = -1;
   // Directional lights with the GPU tests: a depth-only pass (no fragment output; the tests read
-  // the window depth and unproject it), which a software rasteriser fills in about half the time.
+  // the window depth and unproject it): the visibility stage of 100 k x 32 on llvmpipe -11 %.
   GLuint depth_only_program_ = 0;
   GLint d_view_ = -1, d_projection_ = -1;
   GlRenderTarget camera_target_, light_target_, light_window_target_;
@@ -203,7 +203,8 @@ void GlVisibility::upload_mesh() {
                  GL_STATIC_DRAW);
 }
 
-// Renders the nearest linear depth into `t`. The caller holds a GlStateGuard.
+// Renders the nearest linear depth into `t`, or with `depth_only` (a WindowDepth target) only
+// the rasteriser's window depth. The caller holds a GlStateGuard.
 void GlVisibility::render_depth(const GlRenderTarget &t, const Mat4 &view, const Mat4 &projection,
                                 const std::string &what, bool depth_only) {
   gl_.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
