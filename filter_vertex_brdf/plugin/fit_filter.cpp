@@ -104,7 +104,8 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "What k_d multiplies: N.L (Lambert, the thesis) or N.L scaled by a clear coat's "
                            "Fresnel transmission on the way in and out (varnish, glaze, plastic: the diffuse "
                            "light dims at grazing light and view; the colour then holds from other cameras). "
-                           "Auto: a quick pilot fit of both with every 4th photo held out picks the one that "
+                           "Auto: a quick pilot fit of both with every 4th photo held out (in turn, until 8 photos "
+                           "were) picks the one that "
                            "predicts those photos better (the report says which). Written with the result "
                            "(per-vertex diffuse_form) and used by every later step."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
