@@ -3,10 +3,11 @@
 // made from normals, or an occluder left out of the mesh (a support, a hand) leaves samples the
 // shadow passes call lit although the photo is dark there. Fitted as lit, they pull the vertex's
 // k_d down and its lobe wide. After the per-vertex fit (either back end) each vertex's samples are
-// held against its model: a sample far darker than the model predicts is flagged kCastShadow (a
-// shadow cast by something the mesh lacks; every later stage leaves shadowed samples out) and the
-// vertex is fitted again on the CPU. Safeguards: only where the model predicts clearly more than noise, never more than half of
-// a vertex's usable samples, and never leaving fewer than kPhotoShadowMinRemaining; one pass.
+// held against its model: a sample far darker than the model's diffuse part predicts is flagged
+// kCastShadow (a shadow cast by something the mesh lacks; every later stage leaves shadowed
+// samples out) and the vertex is fitted again on the CPU. Safeguards: only where the model
+// predicts clearly more than noise, never more than half of a vertex's usable samples, and never
+// leaving fewer than kPhotoShadowMinRemaining; one pass.
 #include <cstddef>
 
 #include "fit/phong_fit.h"
@@ -24,8 +25,9 @@ constexpr size_t kPhotoShadowMinRemaining = 3;
 
 // Flags (kCastShadow) the samples of one vertex that `fit` (its model) says should be lit and the
 // photo shows in shadow (darker than darker_than x the model's diffuse part k_d C d, so that a lobe
-// that overshoots a sample does not make it a "shadow"), under the safeguards above. Usable: not shadowed, saturated or unseen,
-// diffuse factor d > 0, finite. Returns how many were flagged; 0 leaves the samples as they were.
+// that overshoots a sample does not make it a "shadow"), under the safeguards above. Usable: not
+// shadowed, saturated or unseen, diffuse factor d > 0, finite. Returns how many were flagged; 0
+// leaves the samples as they were.
 size_t flag_photo_shadows(const VertexFit &fit, Sample *samples, size_t count, const PhotoShadowSettings &settings);
 
 // Per chunk (after the fit): flags every modelled vertex's photo shadows and refits the vertices

@@ -75,28 +75,40 @@ void check_gl_target_size(const GlApi &gl, int width, int height, const std::str
 }
 
 namespace {
+// (Re)allocates texture `name` as width x height float data of `format`, read texel by texel
+// (nearest, one level). Its contents are undefined until drawn.
+void allocate_float_texture(const GlApi &gl, GLuint name, GLint format, GLenum channels, int width, int height) {
+  gl.BindTexture(GL_TEXTURE_2D, name);
+  gl.TexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, channels, GL_FLOAT, nullptr);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+}
+
+// The bound framebuffer of `t` is attached: throws when the allocation or the framebuffer failed,
+// else records its size.
+void finish_render_target(const GlApi &gl, GlRenderTarget &t, int width, int height, const std::string &what) {
+  check_gl_error(gl, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
+                         " render target for " + what);
+  check_framebuffer(gl, GL_FRAMEBUFFER, what);
+  t.width = width;
+  t.height = height;
+}
+
 void ensure_window_depth_target(const GlApi &gl, GlRenderTarget &t, int width, int height, const std::string &what) {
   if (!t.fbo) {
     gl.GenFramebuffers(1, &t.fbo);
     gl.GenTextures(1, &t.color);
   }
   gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
-  gl.BindTexture(GL_TEXTURE_2D, t.color);
-  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  allocate_float_texture(gl, t.color, GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, width, height);
   gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_NONE);  // texelFetch reads the depth itself
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
   gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, t.color, 0);
   const GLenum none = GL_NONE;
   gl.DrawBuffers(1, &none);
   gl.ReadBuffer(GL_NONE);
-  check_gl_error(gl, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
-                         " depth target for " + what);
-  check_framebuffer(gl, GL_FRAMEBUFFER, what);
-  t.width = width;
-  t.height = height;
+  finish_render_target(gl, t, width, height, what);
 }
 } // namespace
 
@@ -130,15 +142,8 @@ void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
   }
   if (shading && !t.extra) gl.GenTextures(1, &t.extra);
   gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
-  const auto texture = [&](GLuint name, GLint format, GLenum channels) {
-    gl.BindTexture(GL_TEXTURE_2D, name);
-    gl.TexImage2D(GL_TEXTURE_2D, 0, format, width, height, 0, channels, GL_FLOAT, nullptr);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
-  };
-  texture(t.color, shading ? GL_RGBA32F : GL_R32F, shading ? GL_RGBA : GL_RED);
-  if (shading) texture(t.extra, GL_R32F, GL_RED);
+  allocate_float_texture(gl, t.color, shading ? GL_RGBA32F : GL_R32F, shading ? GL_RGBA : GL_RED, width, height);
+  if (shading) allocate_float_texture(gl, t.extra, GL_R32F, GL_RED, width, height);
   gl.BindRenderbuffer(GL_RENDERBUFFER, t.depth);
   gl.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
   gl.BindFramebuffer(GL_FRAMEBUFFER, t.fbo);
@@ -148,11 +153,7 @@ void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
   const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
   gl.DrawBuffers(shading ? 2 : 1, buffers);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
-  check_gl_error(gl, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
-                         " render target for " + what);
-  check_framebuffer(gl, GL_FRAMEBUFFER, what);
-  t.width = width;
-  t.height = height;
+  finish_render_target(gl, t, width, height, what);
 }
 
 void release_render_target(const GlApi &gl, GlRenderTarget &t) {

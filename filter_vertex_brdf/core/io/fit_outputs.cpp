@@ -164,7 +164,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   rep << "  rim samples left out because their vertex has >= 2 clean samples: " << r.rim_samples_demoted << "\n";
   if (settings.fit_reflectance)
     rep << "  in a shadow the photo shows but the mesh does not cast (darker than "
-        << settings.photo_shadows.darker_than << " x the vertex's model; left out, vertex fitted again): "
+        << settings.photo_shadows.darker_than << " x the diffuse part of the vertex's model; left out, vertex fitted again): "
         << (settings.photo_shadows.enabled ? std::to_string(r.photo_shadow_samples) + " samples, " +
                                                  std::to_string(r.photo_shadow_vertices) + " vertices"
                                            : std::string("off"))

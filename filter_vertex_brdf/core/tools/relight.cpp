@@ -111,13 +111,11 @@ void fit_vertex_baseline(const BaselinePlan &plan, int viewpoint, const Sample *
   fit_rbf(out.dirs.data(), rgb.data(), out.count, vp.sigma, rbf_ridge, out.weights.data());
 }
 
-// One scored held-out sample.
+// One scored held-out sample: what RelightOptions::per_sample keeps, and the bookkeeping of the summaries.
 struct Scored {
   ScoredSample sample;
-  float de, de_ptm, de_rbf;
   float squared_error;  // over the 3 channels, prediction clamped to 1
-  uint16_t raster;
-  bool mixed, modelled, has_baseline;
+  bool modelled, has_baseline;
 };
 
 // The prediction of the photo's bilinear sample at image point (x, y) whose footprint pixels
@@ -229,8 +227,12 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
                                : ((s.flags & kShadowed) || !(s.d > 0)))
           continue;
         Scored r{};
-        r.raster = s.raster;
-        r.mixed = (s.flags & kMixedPixel) != 0;
+        ScoredSample &o = r.sample;
+        o.vertex = uint32_t(v);
+        o.raster = s.raster;
+        o.fit_status = fit.status;
+        o.mixed = (s.flags & kMixedPixel) != 0;
+        o.d = s.d;
         r.modelled = has_model(fit);
         float predicted[3];
         evaluate_phong(fit, s.d, s.lobe_cos, predicted);
@@ -242,8 +244,9 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
           const float at_vertex[3] = {predicted[0], predicted[1], predicted[2]};
           predict_footprint((*options.rendered)[s.raster], ip.x, ip.y, own, at_vertex, predicted);
         }
-        r.de = float(delta_e2000_linear_srgb(predicted, s.rgb));
-        r.de_ptm = r.de_rbf = -1.0f;
+        for (int c = 0; c < 3; ++c) o.observed[c] = s.rgb[c], o.predicted[c] = predicted[c];
+        o.de = float(delta_e2000_linear_srgb(predicted, s.rgb));
+        o.de_ptm = o.de_rbf = -1.0f;
         for (int c = 0; c < 3; ++c) {
           const float e = std::min(predicted[c], 1.0f) - s.rgb[c];
           r.squared_error += e * e;
@@ -256,23 +259,13 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
             float p[3];
             evaluate_ptm(b.ptm, plan.heldout_uv[s.raster][0], plan.heldout_uv[s.raster][1], p);
             clamp_below_zero(p);
-            r.de_ptm = float(delta_e2000_linear_srgb(p, s.rgb));
+            o.de_ptm = float(delta_e2000_linear_srgb(p, s.rgb));
             evaluate_rbf(b.dirs.data(), b.weights.data(), b.count, plan.viewpoints[size_t(vp)].sigma,
                          light_dirs_world[s.raster].data(), p);
             clamp_below_zero(p);
-            r.de_rbf = float(delta_e2000_linear_srgb(p, s.rgb));
+            o.de_rbf = float(delta_e2000_linear_srgb(p, s.rgb));
             r.has_baseline = true;
           }
-        }
-        if (options.per_sample) {
-          ScoredSample &o = r.sample;
-          o.vertex = uint32_t(v);
-          o.raster = s.raster;
-          o.fit_status = fit.status;
-          o.mixed = r.mixed;
-          o.d = s.d;
-          for (int c = 0; c < 3; ++c) o.observed[c] = s.rgb[c], o.predicted[c] = predicted[c];
-          o.de = r.de, o.de_ptm = r.de_ptm, o.de_rbf = r.de_rbf;
         }
         scored[i].push_back(r);
       }
@@ -283,16 +276,17 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         ++stats.seen_vertices;
         if (!modelled) ++stats.seen_unmodelled_vertices;
       }
-      for (const Scored &r : scored[i]) {
-        if (options.per_sample) options.per_sample->push_back(r.sample);
+      for (const Scored &scored_sample : scored[i]) {
+        const ScoredSample &r = scored_sample.sample;
+        if (options.per_sample) options.per_sample->push_back(r);
         de_all.push_back(r.de);
-        squared_error += r.squared_error;
+        squared_error += scored_sample.squared_error;
         stats.per_raster_mean_de2000[r.raster] += r.de;
         ++stats.per_raster_samples[r.raster];
-        if (!r.modelled) ++stats.unmodelled_samples;
-        if (r.modelled && !r.mixed) de_clean.push_back(r.de);
+        if (!scored_sample.modelled) ++stats.unmodelled_samples;
+        if (scored_sample.modelled && !r.mixed) de_clean.push_back(r.de);
         if (!baselines) continue;
-        if (!r.has_baseline) {
+        if (!scored_sample.has_baseline) {
           ++stats.baseline_excluded;
           continue;
         }
