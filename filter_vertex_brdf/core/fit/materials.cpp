@@ -85,6 +85,10 @@ inline double lobe_of(float log_s, double alpha) {
   return std::exp(std::max(alpha * double(log_s), -80.0));
 }
 
+// (s^alpha)^2 = s^(2 alpha), as 0 below lobe_of's floor exp(-80): repeated squaring would otherwise
+// walk through denormals (slow, and meaningless as a weight).
+inline double square_lobe(double g) { return g < 1.8e-35 ? 0.0 : g * g; }
+
 std::vector<Static> static_sums(const Context &c, int set) {
   std::vector<Static> out(c.n);
   const auto &E = c.store.entries();
@@ -199,7 +203,7 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
       const float ls = (*c.log_s)[k];
       if (ls > 0 || !c.in_set(e, set)) continue;
       for (size_t i = 0; i < ng; ++i)
-        g[i] = squared[i] ? g[i - kGridStepsPerDoubling] * g[i - kGridStepsPerDoubling] : lobe_of(ls, grid[i]);
+        g[i] = squared[i] ? square_lobe(g[i - kGridStepsPerDoubling]) : lobe_of(ls, grid[i]);
       for (size_t i = 0; i < ng; ++i) {
         if (g[i] == 0) continue;
         Lobe &Li = Lv[i];
@@ -525,6 +529,7 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
   for (int m = 1; m <= K; ++m) mean_info[size_t(m)] = cnt[size_t(m)] > 0 ? mean_info[size_t(m)] / cnt[size_t(m)] : 0;
   const size_t nc = choices.size();
   // Only the material's own alpha (k = kAlphaCentre) is needed when no choice has a per-vertex alpha.
+  const bool same_sets = fit_set == score_set;  // then the score's lobe sums are the fit's
   const bool centre_only = std::all_of(choices.begin(), choices.end(), [](const Choice &ch) { return ch.alpha_prior < 0; });
   std::vector<double> score(c.n * nc, 0.0);
   if (params) params->ks.assign(c.n, 0), params->rho.assign(3 * c.n, 0), params->alpha.assign(c.n, 0);
@@ -558,14 +563,14 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
       if ((!f && !sc) || (*c.log_s)[i] > 0) continue;
       if (doubling && !centre_only) {  // 4 exponentials, the rest by squaring: s^(2 alpha) = (s^alpha)^2
         for (int k = 0; k < 4; ++k) g_of[k] = lobe_of((*c.log_s)[i], alpha[k]);
-        for (int k = 4; k < kAlphaSteps; ++k) g_of[k] = g_of[k - 4] * g_of[k - 4];
+        for (int k = 4; k < kAlphaSteps; ++k) g_of[k] = square_lobe(g_of[k - 4]);
       } else {
         for (int k = k_first; k <= k_last; ++k) g_of[k] = lobe_of((*c.log_s)[i], alpha[k]);
       }
       for (int k = k_first; k <= k_last; ++k) {
         const double g = g_of[k];
         if (g == 0) continue;
-        for (Lobe *L : {f ? &Lf[k] : nullptr, sc ? &Ls[k] : nullptr}) {
+        for (Lobe *L : {f ? &Lf[k] : nullptr, sc && !same_sets ? &Ls[k] : nullptr}) {
           if (!L) continue;
           L->b += double(e.w) * e.d * g, L->g2 += double(e.w) * g * g;
           for (int ch = 0; ch < 3; ++ch) L->q[ch] += double(e.w) * g * e.rgb[ch];
@@ -590,7 +595,7 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
       }
       double rho[3];
       energy_ks(S_fit[v], Lf[best_k], best_ks, rho);
-      score[v * nc + ch] = energy_fixed(S_score[v], Ls[best_k], best_ks, rho);
+      score[v * nc + ch] = energy_fixed(S_score[v], same_sets ? Lf[best_k] : Ls[best_k], best_ks, rho);
       if (params && ch == 0) {
         params->ks[v] = best_ks, params->alpha[v] = alpha[best_k];
         std::copy(rho, rho + 3, &params->rho[3 * v]);
@@ -660,8 +665,10 @@ void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[
 // kSelectionVertices remain (all of them on smaller meshes). The choice compares held-out errors
 // summed over the same vertices for every K, so an even subsample ranks them as the whole mesh
 // does; the chosen configuration is then refitted on every vertex (fit_materials step 2). On the
-// benchmark's 100 k vertices (45 k eligible) the choice took 3.96 s of the stage's 4.6 s.
-constexpr size_t kSelectionVertices = 6000;
+// benchmark's 100 k vertices (45 k eligible) the choice took 3.96 s of the stage's 4.6 s on all of
+// them, 0.3-0.5 s on 6000 and 0.27 s on 3000 (same K, lobes and shared-scene figures: README).
+constexpr size_t kSelectionVertices = 3000;
+size_t count_eligible(const Context &c) { return size_t(std::count(c.eligible.begin(), c.eligible.end(), uint8_t(1))); }
 Context selection_subsample(const Context &c, size_t eligible) {
   Context sel = c;
   const size_t stride = (eligible + kSelectionVertices - 1) / kSelectionVertices;
@@ -778,6 +785,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
       << (R.chosen_alpha_prior < 0 ? std::string("= the material's") : "prior strength " + fixed(R.chosen_alpha_prior, 3))
       << "\n";
 
+  const double seconds_choice = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // 2. Refit the chosen configuration on all samples and vertices (the subsample's labels spread
   // over the mesh first).
   const std::vector<Static> S = static_sums(c, kAll);
@@ -859,7 +867,8 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   R.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rep << "  vertices given a lobe that had none: " << R.vertices_changed_to_specular
       << "; vertices set diffuse (in a diffuse material): " << R.vertices_set_diffuse << "; samples kept "
-      << fixed(double(R.bytes_kept) / (1 << 20), 1) << " MB; " << fixed(R.seconds, 2) << " s (CPU, double)\n";
+      << fixed(double(R.bytes_kept) / (1 << 20), 1) << " MB; " << fixed(R.seconds, 2) << " s (CPU, double; choosing K on "
+      << count_eligible(sel) << " vertices " << fixed(seconds_choice, 2) << " s)\n";
   R.report = rep.str();
   return R;
 }
