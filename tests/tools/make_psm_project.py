@@ -86,6 +86,7 @@ DARK_FRACTION = 0.1   # a sample darker than this fraction of the pixel's bright
 DARK_ABS = 0.004      # linear grey below this counts as dark in any case
 MIN_SAMPLES = 4       # keep dropping dark/saturated samples only while this many remain
 MAX_SLOPE = 6.0       # |dz/dx| clip for the integration (about 80 degrees)
+MIN_NZ = 0.05         # smallest N.E of a photometric-stereo normal (about 87 degrees from the view)
 PIXEL_SIZE_MM = 0.01
 REGISTRATION_TOL_PX = 0.01
 
@@ -389,8 +390,14 @@ def photometric_normals(grey, saturated, lights):
     ok &= albedo > 1e-9
     normals = np.tile(np.array([0.0, 0.0, 1.0]), (n, 1))
     normals[ok] = g[ok] / albedo[ok, None]
-    flip = normals[:, 2] < 0          # a surface seen by the camera faces it
-    normals[flip, 2] = 0.0
+    # A surface the camera sees faces it: N.E >= MIN_NZ (the camera looks along -z). Noise can tilt a
+    # rim pixel's normal past 90 degrees; nz = 0 would make the vertex edge-on, and the fit would
+    # count it as seen by no photo (owl: 12 vertices).
+    low = normals[:, 2] < MIN_NZ
+    normals[low, 2] = 0.0
+    tangential = np.linalg.norm(normals[low, :2], axis=1, keepdims=True).clip(1e-12)
+    normals[low, :2] *= np.sqrt(1.0 - MIN_NZ ** 2) / tangential
+    normals[low, 2] = MIN_NZ
     normals /= np.linalg.norm(normals, axis=1, keepdims=True).clip(1e-12)
     normals[np.linalg.norm(normals, axis=1) < 0.5] = (0.0, 0.0, 1.0)
     return normals, np.where(ok, albedo, 0.0), use.sum(axis=0)

@@ -157,6 +157,15 @@ def check_object(args, name):
         status = fit['fit_status']
         shares = ', '.join('%d: %.1f %%' % (s, 100.0 * np.mean(status == s)) for s in np.unique(status))
         print('  fit_status shares (of %d vertices): %s' % (len(status), shares))
+        # Every object pixel is in view by construction (issue 9: vertices without a model 0), so one
+        # without a model means the builder or the visibility lost it (e.g. an edge-on normal).
+        obj = read_ply_vertices(os.path.join(out, 'object_pixels.ply'))
+        if 'visible' in obj.dtype.names and len(obj) == len(status):
+            on_object = obj['visible'] > 0
+            no_model = int(np.sum(on_object & (status == 0)))
+            print('  object pixels without a model: %d of %d' % (no_model, int(on_object.sum())))
+            if no_model:
+                failures.append('%s: %d object pixels without a model' % (name, no_model))
         if not failures:
             failures += sampling_check(args, name, fit, mask)
 

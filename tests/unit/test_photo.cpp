@@ -52,7 +52,7 @@ TEST(Photo, EightBitIsSrgbAndSixteenBitIsLinearByDefault) {
   EXPECT_NEAR(sample_bilinear(lin8, 2, 2).rgb[1], 128 / 255.0f, 1e-6);
 }
 
-TEST(Photo, BilinearUsesPixelCentresAndDetectsBorders) {
+TEST(Photo, BilinearUsesPixelCentresAndRepeatsBorders) {
   cv::Mat img(2, 3, CV_16UC3, cv::Scalar(0, 0, 0));
   img.at<cv::Vec3w>(0, 0) = cv::Vec3w(0, 0, 10000);  // R of top-left pixel
   img.at<cv::Vec3w>(0, 1) = cv::Vec3w(0, 0, 30000);
@@ -62,8 +62,20 @@ TEST(Photo, BilinearUsesPixelCentresAndDetectsBorders) {
   ASSERT_TRUE(s.inside);
   EXPECT_NEAR(s.rgb[0], 20000 / 65535.0f, 1e-6);
   EXPECT_FALSE(s.saturated);
-  EXPECT_FALSE(sample_bilinear(p, 0.2f, 0.5f).inside);   // footprint leaves the image
-  EXPECT_FALSE(sample_bilinear(p, 2.8f, 1.0f).inside);
+  // On the image but beyond the border pixels' centres: the border pixel is repeated (an object
+  // touching the frame keeps its outermost pixels).
+  s = sample_bilinear(p, 0.2f, 0.5f);
+  ASSERT_TRUE(s.inside);
+  EXPECT_NEAR(s.rgb[0], 10000 / 65535.0f, 1e-6);
+  s = sample_bilinear(p, 2.8f, 1.0f);  // right column (black), halfway between the rows
+  ASSERT_TRUE(s.inside);
+  EXPECT_NEAR(s.rgb[0], 0.0f, 1e-6);
+  s = sample_bilinear(p, 1.5f, 0.2f);  // top row, pixel (1,0)'s centre column
+  ASSERT_TRUE(s.inside);
+  EXPECT_NEAR(s.rgb[0], 30000 / 65535.0f, 1e-6);
+  EXPECT_FALSE(sample_bilinear(p, -0.1f, 0.5f).inside);  // off the image
+  EXPECT_FALSE(sample_bilinear(p, 3.0f, 1.0f).inside);
+  EXPECT_FALSE(sample_bilinear(p, 1.0f, 2.0f).inside);
   EXPECT_FALSE(sample_bilinear(p, std::nanf(""), 1.0f).inside);
 }
 

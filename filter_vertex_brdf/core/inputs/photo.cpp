@@ -97,10 +97,15 @@ namespace {
 template <typename T>
 PixelSample bilinear(const Photo &photo, float x, float y, uint8_t texels) {
   PixelSample out;
+  // A point on the image (x in [0, W), y in [0, H)) is sampled even in the outer half of a border
+  // pixel: the footprint's texels beyond the border repeat the border pixel (OpenCV's
+  // BORDER_REPLICATE), so an object that touches the frame keeps its outermost pixels.
+  const int width = photo.width(), height = photo.height();
+  if (!(x >= 0 && y >= 0 && x < float(width) && y < float(height)) || (texels & 0xF) == 0) return out;
   // Pixel centres are at +0.5: shift to centre-based coordinates.
   const float fx = x - 0.5f, fy = y - 0.5f;
   const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= photo.width() || y0 + 1 >= photo.height() || (texels & 0xF) == 0) return out;
+  const int xs[2] = {std::max(x0, 0), std::min(x0 + 1, width - 1)}, ys[2] = {std::max(y0, 0), std::min(y0 + 1, height - 1)};
   out.inside = true;
   const float ax = fx - float(x0), ay = fy - float(y0);
   float w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
@@ -110,11 +115,11 @@ PixelSample bilinear(const Photo &photo, float x, float y, uint8_t texels) {
     for (int k = 0; k < 4; ++k) w[k] = (texels >> k & 1u) ? 1.0f : 0.0f;
   total = 0;
   for (float wk : w) total += wk;
-  const T *rows[2] = {photo.pixels.ptr<T>(y0), photo.pixels.ptr<T>(y0 + 1)};
+  const T *rows[2] = {photo.pixels.ptr<T>(ys[0]), photo.pixels.ptr<T>(ys[1])};
   const int n = photo.pixels.channels();
   for (int k = 0; k < 4; ++k) {
     if (w[k] == 0 && texels != 0xF) continue;
-    const T *px = rows[k / 2] + n * (x0 + (k % 2));
+    const T *px = rows[k / 2] + n * xs[k % 2];
     for (int c = 0; c < 3; ++c) {
       const T code = px[photo.rgb[size_t(c)]];
       if (int(code) >= photo.saturation_code) out.saturated = true;

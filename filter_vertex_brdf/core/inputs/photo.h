@@ -73,11 +73,13 @@ cv::Mat decode_to_linear(const cv::Mat &image, bool decode_srgb);
 
 struct PixelSample {
   float rgb[3] = {0, 0, 0};  // linear
-  bool inside = false;       // the bilinear footprint is inside the image
+  bool inside = false;       // the point is on the image (footprint texels beyond its border repeat the border pixel)
   bool saturated = false;    // any channel of any of the 4 footprint pixels is clipped
 };
 
-// Bilinear sample at image-pixel coordinates (top-left origin, y down, centres at +0.5).
+// Bilinear sample at image-pixel coordinates (top-left origin, y down, centres at +0.5), for a
+// point on the image (x in [0, W), y in [0, H)); beyond the border the footprint repeats the
+// border pixel.
 // `texels` (visibility.h's footprint mask: bit k = texel (x0 + k % 2, y0 + k / 2)) restricts the
 // footprint to some of its 4 texels, their bilinear weights renormalised; when those weights sum
 // to almost nothing (the point sits on the far side of the kept texels) the kept texels are

@@ -194,7 +194,7 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
     const bool own_only = partial && settings.own_surface_texels && own_texels != 0;
     if (partial) flags |= own_only ? kRimFootprint : kMixedPixel;
     const PixelSample px = sample_bilinear(photo, ip.x, ip.y, own_only ? own_texels : kAllFootprintTexels);
-    if (!px.inside) flags |= kOffImage;  // bilinear footprint crosses the image border
+    if (!px.inside) flags |= kOffImage;  // not on the photo (or no footprint texel kept)
     if (px.saturated) flags |= kSaturated;
     for (int c = 0; c < 3; ++c) out.rgb[c] = px.rgb[c];
   }
