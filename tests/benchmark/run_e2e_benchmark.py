@@ -4,7 +4,8 @@ errors of the fit filter at its defaults, on synthetic captures made by synthesi
 
   run_e2e_benchmark.py --wrapper <build>/meshlab_run/run_meshlabserver.sh
                        --synth <build>/tests/tools/synthesize_scene --work DIR
-                       [--cases 100k,1m] [--repeats N] [--baseline-wrapper OTHER.sh] [--out FILE.md]
+                       [--cases 100k,1m] [--repeats N] [--baseline-wrapper OTHER.sh [--baseline-mlx OLD.mlx]]
+                       [--out FILE.md]
 
 Cases (scenes generated once into --work and reused):
   100k  100 k vertices x 32 photos, 1024x768 (4 held-out photos)
@@ -22,6 +23,10 @@ fit modelled:
 With --baseline-wrapper (another build's wrapper, e.g. main's), every case also runs there, runs
 alternate between the two (the machine is shared: ratios of the same session are the measure),
 and the outputs are compared vertex by vertex (vertices modelled by one only, k_d difference).
+--baseline-mlx: the fit script template for the baseline build (default: this checkout's
+sample_projects/synth_basic/fit.mlx). meshlabserver 2020.09 refuses a script listing a parameter its
+filter does not have, so a build from before a new parameter needs its own, e.g.
+`git show <rev>:sample_projects/synth_basic/fit.mlx > old.mlx`.
 The fastest of --repeats runs is reported; the slowest is kept beside it.
 Needs numpy (tests/e2e/e2e_lib.py reads the PLY files).
 """
@@ -59,11 +64,11 @@ def make_scene(synth, work, case):
     return out
 
 
-def write_mlx(path, output_ply):
-    text = open(FIT_MLX).read()
+def write_mlx(path, output_ply, template=FIT_MLX):
+    text = open(template).read()
     text, n = re.subn(r'(name="outputPly" type="RichString" value=")[^"]*"', r'\g<1>' + output_ply + '"', text)
     if n != 1:
-        raise RuntimeError(f"{FIT_MLX}: no outputPly parameter")
+        raise RuntimeError(f"{template}: no outputPly parameter")
     with open(path, "w") as f:
         f.write(text)
 
@@ -85,10 +90,10 @@ def parse_report(path):
     return stages
 
 
-def run_once(wrapper, scene, work, label):
+def run_once(wrapper, scene, work, label, template=FIT_MLX):
     ply = os.path.join(work, f"{label}.ply")
     mlx = os.path.join(work, f"{label}.mlx")
-    write_mlx(mlx, ply)
+    write_mlx(mlx, ply, template)
     cmd = ["/usr/bin/time", "-v", wrapper, "-p", os.path.join(scene, "project.mlp"), "-s", mlx]
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     with open(os.path.join(work, f"{label}.log"), "w") as f:
@@ -137,6 +142,7 @@ def main():
     ap.add_argument("--cases", default="100k")
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--baseline-wrapper", default="")
+    ap.add_argument("--baseline-mlx", default=FIT_MLX, help="fit script template for the baseline build")
     ap.add_argument("--out", default="")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
@@ -151,7 +157,8 @@ def main():
         runs = {name: [] for name, _ in builds}
         for rep in range(args.repeats):
             for name, wrapper in builds:  # alternate: the same load falls on both builds
-                row = run_once(wrapper, scene, args.work, f"{case}_{name}_{rep}")
+                row = run_once(wrapper, scene, args.work, f"{case}_{name}_{rep}",
+                               args.baseline_mlx if name == "baseline" else FIT_MLX)
                 log(f"[{case}] {name} run {rep + 1}: {row['wall']:.2f} s, peak {row['rss_gb']:.2f} GB, "
                     f"visibility {row.get('visibility')} s, samples {row.get('samples')} s, fit {row.get('fit')} s")
                 runs[name].append(row)
