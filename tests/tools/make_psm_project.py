@@ -394,7 +394,6 @@ def photometric_normals(grey, saturated, lights):
     # rim pixel's normal past 90 degrees; nz = 0 would make the vertex edge-on, and the fit would
     # count it as seen by no photo (owl: 12 vertices).
     low = normals[:, 2] < MIN_NZ
-    normals[low, 2] = 0.0
     tangential = np.linalg.norm(normals[low, :2], axis=1, keepdims=True).clip(1e-12)
     normals[low, :2] *= np.sqrt(1.0 - MIN_NZ ** 2) / tangential
     normals[low, 2] = MIN_NZ

@@ -84,6 +84,26 @@ StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions(
   return r;
 }
 
+// For a stage run that found two materials: which is the glossy one (the one holding most truly
+// glossy vertices; returned, 1 or 2). Expects >= 95 % of the vertices labelled as the truth says,
+// the other material diffuse, and the glossy lobe's k_s and alpha within 10 %.
+int expect_two_materials_found(const Scene &sc, const StageRun &r, float ks, float alpha) {
+  size_t agree[3][3] = {};
+  for (size_t v = 0; v < sc.truth.size(); ++v) {
+    const int32_t label = r.result.label[v];
+    ++agree[sc.truth[v]][label >= 1 && label <= 2 ? size_t(label) : 0];
+  }
+  const int glossy = agree[1][1] >= agree[1][2] ? 1 : 2, diffuse = 3 - glossy;
+  const double correct = double(agree[1][size_t(glossy)] + agree[2][size_t(diffuse)]) / double(sc.truth.size());
+  EXPECT_GE(correct, 0.95) << r.result.report;
+  const Material &g = r.result.materials[size_t(glossy) - 1], &d = r.result.materials[size_t(diffuse) - 1];
+  EXPECT_FALSE(g.diffuse);
+  EXPECT_TRUE(d.diffuse) << r.result.report;
+  EXPECT_NEAR(g.shininess, alpha, 0.1 * alpha) << r.result.report;
+  EXPECT_NEAR(g.ks, ks, 0.1 * ks) << r.result.report;
+  return glossy;
+}
+
 } // namespace
 
 
@@ -100,17 +120,8 @@ TEST_P(MaterialsBothLobes, TwoMaterialsAndTheirLobesAreRecovered) {
   const StageRun r = run_stage(sc, everywhere, form);
   ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
   ASSERT_EQ(r.result.materials.size(), 2u);
-  // Which found material is the glossy one: the one holding most truly glossy vertices.
-  size_t agree[3][3] = {};
-  for (size_t v = 0; v < sc.truth.size(); ++v) ++agree[sc.truth[v]][size_t(r.result.label[v])];
-  const int glossy = agree[1][1] >= agree[1][2] ? 1 : 2, diffuse = 3 - glossy;
-  const double correct = double(agree[1][size_t(glossy)] + agree[2][size_t(diffuse)]) / double(sc.truth.size());
-  EXPECT_GE(correct, 0.95) << r.result.report;
-  const Material &g = r.result.materials[size_t(glossy) - 1], &d = r.result.materials[size_t(diffuse) - 1];
-  EXPECT_FALSE(g.diffuse);
-  EXPECT_TRUE(d.diffuse) << r.result.report;
-  EXPECT_NEAR(g.shininess, alpha, 0.1 * alpha) << r.result.report;
-  EXPECT_NEAR(g.ks, ks, 0.1 * ks) << r.result.report;
+  const int glossy = expect_two_materials_found(sc, r, ks, alpha);
+  const Material &g = r.result.materials[size_t(glossy) - 1];
   // Every vertex of the glossy material has a lobe, every one of the diffuse material none; the
   // per-vertex fit alone left many glossy vertices without one.
   size_t glossy_n = 0, glossy_ks = 0, glossy_ks_before = 0, diffuse_n = 0, diffuse_ks0 = 0;
@@ -140,7 +151,7 @@ TEST_P(MaterialsBothLobes, TwoMaterialsAndTheirLobesAreRecovered) {
       << glossy_ks_before << " of " << glossy_n;
 }
 
-// Above about 6000 vertices K and the priors are chosen on an even subsample of the vertices
+// Above about 3000 vertices K and the priors are chosen on an even subsample of the vertices
 // (materials.cpp selection_subsample), then the choice is spread over the mesh and refitted on
 // every vertex: 14 641 vertices must give the same answer as the whole mesh would: two materials,
 // the right one diffuse, the glossy lobe within 10 %, every vertex labelled and as the truth says.
@@ -150,20 +161,11 @@ TEST(Materials, ChosenOnASubsampleOfALargeMesh) {
   ASSERT_GT(sc.truth.size(), 12000u);
   const StageRun r = run_stage(sc, MaterialOptions(), LobeForm::BlinnNH);
   ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
-  size_t agree[3][3] = {}, unlabelled = 0;
-  for (size_t v = 0; v < sc.truth.size(); ++v) {
-    unlabelled += r.result.label[v] <= 0 || r.result.label[v] > 2;
-    if (r.result.label[v] > 0 && r.result.label[v] <= 2) ++agree[sc.truth[v]][size_t(r.result.label[v])];
-  }
+  ASSERT_EQ(r.result.materials.size(), 2u);
+  size_t unlabelled = 0;
+  for (int32_t label : r.result.label) unlabelled += label <= 0 || label > 2;
   EXPECT_EQ(unlabelled, 0u);
-  const int glossy = agree[1][1] >= agree[1][2] ? 1 : 2, diffuse = 3 - glossy;
-  const double correct = double(agree[1][size_t(glossy)] + agree[2][size_t(diffuse)]) / double(sc.truth.size());
-  EXPECT_GE(correct, 0.95) << r.result.report;
-  const Material &g = r.result.materials[size_t(glossy) - 1], &d = r.result.materials[size_t(diffuse) - 1];
-  EXPECT_FALSE(g.diffuse);
-  EXPECT_TRUE(d.diffuse) << r.result.report;
-  EXPECT_NEAR(g.shininess, alpha, 0.1 * alpha) << r.result.report;
-  EXPECT_NEAR(g.ks, ks, 0.1 * ks) << r.result.report;
+  expect_two_materials_found(sc, r, ks, alpha);
 }
 
 INSTANTIATE_TEST_SUITE_P(LobeForms, MaterialsBothLobes, ::testing::Values(LobeForm::PhongRE, LobeForm::BlinnNH),

@@ -108,6 +108,17 @@ std::vector<Static> static_sums(const Context &c, int set) {
   return out;
 }
 
+// Adds sample e with lobe value g = s^alpha to the lobe sums.
+inline void add_to_lobe(Lobe &L, const Entry &e, double g) {
+  L.b += double(e.w) * e.d * g, L.g2 += double(e.w) * g * g;
+  for (int ch = 0; ch < 3; ++ch) L.q[ch] += double(e.w) * g * e.rgb[ch];
+}
+
+// Pooled k_s from summed k_s equations (num = sum rhs, den = sum info), in [0, ks_max]; 0 without information.
+inline double pooled_ks(double num, double den, const PhongFitOptions &o) {
+  return den > 0 ? std::min(std::max(num / den, 0.0), double(o.ks_max)) : 0.0;
+}
+
 // Lobe sums of every eligible vertex at alpha_of[label[v]] (label 0: skipped).
 // `out` is reused between calls (assign keeps its capacity: no fresh pages to fault in per call).
 void lobe_sums(const Context &c, int set, const std::vector<int32_t> &label, const std::vector<double> &alpha_of,
@@ -123,9 +134,7 @@ void lobe_sums(const Context &c, int set, const std::vector<int32_t> &label, con
       const Entry &e = E[k];
       if (!c.in_set(e, set)) continue;
       const double g = lobe_of((*c.log_s)[k], alpha);
-      if (g == 0) continue;
-      L.b += double(e.w) * e.d * g, L.g2 += double(e.w) * g * g;
-      for (int ch = 0; ch < 3; ++ch) L.q[ch] += double(e.w) * g * e.rgb[ch];
+      if (g != 0) add_to_lobe(L, e, g);
     }
   }
 }
@@ -193,22 +202,21 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
     if (c.eligible[v] && label[v] > 0) verts.push_back(uint32_t(v));
   std::vector<Lobe> L(verts.size() * ng);
   const auto &entries = c.store.entries();
-#pragma omp parallel for schedule(dynamic, 64) if (verts.size() > 2000)
-  for (long long t = 0; t < (long long)verts.size(); ++t) {
-    const size_t v = verts[size_t(t)];
-    Lobe *Lv = &L[size_t(t) * ng];
-    std::vector<double> g(ng);
-    for (uint64_t k = c.store.first(v); k < c.store.last(v); ++k) {
-      const Entry &e = entries[k];
-      const float ls = (*c.log_s)[k];
-      if (ls > 0 || !c.in_set(e, set)) continue;
-      for (size_t i = 0; i < ng; ++i)
-        g[i] = squared[i] ? square_lobe(g[i - kGridStepsPerDoubling]) : lobe_of(ls, grid[i]);
-      for (size_t i = 0; i < ng; ++i) {
-        if (g[i] == 0) continue;
-        Lobe &Li = Lv[i];
-        Li.b += double(e.w) * e.d * g[i], Li.g2 += double(e.w) * g[i] * g[i];
-        for (int ch = 0; ch < 3; ++ch) Li.q[ch] += double(e.w) * g[i] * e.rgb[ch];
+#pragma omp parallel if (verts.size() > 2000)
+  {
+    std::vector<double> g(ng);  // the sample's lobe at every grid alpha (one buffer per thread)
+#pragma omp for schedule(dynamic, 64)
+    for (long long t = 0; t < (long long)verts.size(); ++t) {
+      const size_t v = verts[size_t(t)];
+      Lobe *Lv = &L[size_t(t) * ng];
+      for (uint64_t k = c.store.first(v); k < c.store.last(v); ++k) {
+        const Entry &e = entries[k];
+        const float ls = (*c.log_s)[k];
+        if (ls > 0 || !c.in_set(e, set)) continue;
+        for (size_t i = 0; i < ng; ++i)
+          g[i] = squared[i] ? square_lobe(g[i - kGridStepsPerDoubling]) : lobe_of(ls, grid[i]);
+        for (size_t i = 0; i < ng; ++i)
+          if (g[i] != 0) add_to_lobe(Lv[i], e, g[i]);
       }
     }
   }
@@ -223,7 +231,7 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
     }
   for (int m = 1; m <= K; ++m)
     for (size_t i = 0; i < ng; ++i)
-      KS[size_t(m)][i] = den[size_t(m)][i] > 0 ? std::min(std::max(num[size_t(m)][i] / den[size_t(m)][i], 0.0), double(c.o.ks_max)) : 0;
+      KS[size_t(m)][i] = pooled_ks(num[size_t(m)][i], den[size_t(m)][i], c.o);
   for (size_t t = 0; t < verts.size(); ++t) {
     const size_t m = size_t(label[verts[t]]);
     for (size_t i = 0; i < ng; ++i) E[m][i] += energy_ks(S[verts[t]], L[t * ng + i], KS[m][i]);
@@ -276,7 +284,7 @@ std::vector<LobeFit> fit_lobes(const Context &c, int set, const std::vector<Stat
     ks_out.assign(size_t(K) + 1, 0);
     e_out.assign(size_t(K) + 1, 0);
     for (int m = 1; m <= K; ++m)
-      ks_out[size_t(m)] = den[size_t(m)] > 0 ? std::min(std::max(num[size_t(m)] / den[size_t(m)], 0.0), double(c.o.ks_max)) : 0;
+      ks_out[size_t(m)] = pooled_ks(num[size_t(m)], den[size_t(m)], c.o);
     for (size_t v = 0; v < c.n; ++v)
       if (c.eligible[v] && which[v] > 0) e_out[size_t(which[v])] += energy_ks(S[v], L[v], ks_out[size_t(which[v])]);
   };
@@ -570,11 +578,8 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
       for (int k = k_first; k <= k_last; ++k) {
         const double g = g_of[k];
         if (g == 0) continue;
-        for (Lobe *L : {f ? &Lf[k] : nullptr, sc && !same_sets ? &Ls[k] : nullptr}) {
-          if (!L) continue;
-          L->b += double(e.w) * e.d * g, L->g2 += double(e.w) * g * g;
-          for (int ch = 0; ch < 3; ++ch) L->q[ch] += double(e.w) * g * e.rgb[ch];
-        }
+        if (f) add_to_lobe(Lf[k], e, g);
+        if (sc && !same_sets) add_to_lobe(Ls[k], e, g);
       }
     }
     for (size_t ch = 0; ch < nc; ++ch) {
