@@ -115,7 +115,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "lobe per material from the samples of all its vertices and give every vertex of a "
                            "glossy material a specular term (a vertex sees one or two highlights, a material "
                            "many); a diffuse material gets none. Writes per-vertex 'material'; the report lists "
-                           "the materials. Holds better from other cameras; costs about a fifth more time."));
+                           "the materials. Holds better from other cameras; costs about a quarter more time."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));

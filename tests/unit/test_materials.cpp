@@ -152,8 +152,8 @@ TEST_P(MaterialsBothLobes, TwoMaterialsAndTheirLobesAreRecovered) {
 }
 
 // Above about 3000 vertices K and the priors are chosen on an even subsample of the vertices
-// (materials.cpp selection_subsample), then the choice is spread over the mesh and refitted on
-// every vertex: 14 641 vertices must give the same answer as the whole mesh would: two materials,
+// (materials.cpp selection_subsample), then the chosen K's materials are found again on every
+// vertex: 14 641 vertices must give the same answer as the whole mesh would: two materials,
 // the right one diffuse, the glossy lobe within 10 %, every vertex labelled and as the truth says.
 TEST(Materials, ChosenOnASubsampleOfALargeMesh) {
   const float ks = 0.5f, alpha = 120.0f;

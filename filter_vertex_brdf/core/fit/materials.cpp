@@ -669,9 +669,9 @@ void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[
 // The vertices on which K and the priors are chosen: every k-th eligible one, k such that about
 // kSelectionVertices remain (all of them on smaller meshes). The choice compares held-out errors
 // summed over the same vertices for every K, so an even subsample ranks them as the whole mesh
-// does; the chosen configuration is then refitted on every vertex (fit_materials step 2). On the
-// benchmark's 100 k vertices (45 k eligible) the choice took 3.96 s of the stage's 4.6 s on all of
-// them, 0.3-0.5 s on 6000 and 0.27 s on 3000 (same K, lobes and shared-scene figures: README).
+// does; the materials of the chosen K are then found again on every vertex (fit_materials step 2).
+// On the benchmark's 100 k vertices (45 k eligible) the choice took 1.68 s on all of them, 0.24 s
+// on 3000 (same K and lobes: README "The material stage's cost").
 constexpr size_t kSelectionVertices = 3000;
 size_t count_eligible(const Context &c) { return size_t(std::count(c.eligible.begin(), c.eligible.end(), uint8_t(1))); }
 Context selection_subsample(const Context &c, size_t eligible) {
@@ -791,17 +791,24 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
       << "\n";
 
   const double seconds_choice = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // 2. Refit the chosen configuration on all samples and vertices (the subsample's labels spread
-  // over the mesh first).
+  // 2. Refit the chosen configuration on all samples and vertices. When K was chosen on a
+  // subsample, the materials are found again on every vertex as the choice found them (k-means
+  // start, mo.iterations alternations): the subsample's labels, spread over the mesh, were not
+  // robust (on the benchmark scene a 1 900-vertex material was lost for one vertex more or less).
   const std::vector<Static> S = static_sums(c, kAll);
-  std::vector<int32_t> start = configs[chosen].label;
-  if (sel.subsampled) {
-    const int k0 = configs[chosen].K;
-    for (size_t v = 0; v < c.n; ++v)
-      if (!sel.eligible[v]) start[v] = 0;
-    spread_labels(c, adj, std::vector<std::vector<double>>(size_t(k0) + 1, std::vector<double>(c.n, 0.0)), k0, start);
+  const int k_chosen = configs[chosen].K;
+  Config fin;
+  if (sel.subsampled && k_chosen > 1) {
+    std::vector<int32_t> all(c.n, 0);
+    for (size_t v = 0; v < c.n; ++v) all[v] = c.eligible[v] ? 1 : 0;
+    const double alpha_one = fit_lobes(c, kAll, S, all, 1)[1].alpha;
+    fin = cluster(c, adj, S, kAll, initial_labels(c, adj, S, kAll, alpha_one, k_chosen), k_chosen, mo.iterations);
+  } else {
+    std::vector<int32_t> start = configs[chosen].label;
+    if (sel.subsampled)  // one material: every eligible vertex in it
+      for (size_t v = 0; v < c.n; ++v) start[v] = c.eligible[v] ? 1 : 0;
+    fin = cluster(c, adj, S, kAll, start, k_chosen, k_chosen > 1 ? 2 : 0);
   }
-  Config fin = cluster(c, adj, S, kAll, start, configs[chosen].K, configs[chosen].K > 1 ? 2 : 0);
   const int K = fin.K;
   R.chosen_k = K;
   std::vector<double> alpha_of(size_t(K) + 1, 1.0);
