@@ -160,6 +160,55 @@ TEST(Samples, GatherStreamsChunksInVertexOrder) {
   EXPECT_EQ(cache.loads(), 1u);          // same photo file: decoded once
 }
 
+// The block a chunk is gathered in holds only the vertices some photo sees: vertices no photo
+// sees get no samples, every other vertex gets exactly the samples make_sample gives it, in
+// raster order, across chunk boundaries that do not fall on a 64-vertex word.
+TEST(Samples, GatherSkipsVerticesNoPhotoSees) {
+  Fixture f;
+  const size_t n = 2500;
+  const MeshData mesh = facing_grid(int(n), 50, -0.5f, -0.4f, 1.0f / 50, 1.0f / 60);
+  const std::vector<Raster> rasters = {f.raster, f.raster, f.raster};
+  const std::vector<LightSource> lights =
+      directional_lights({{{0, 0, 1}}, {{0.6f, 0, 0.8f}}, {{0, 0.6f, 0.8f}}});
+  VisibilityMasks masks = all_seen(n, 3);
+  const size_t words = masks.words();
+  const auto clear_bit = [&](size_t r, size_t v) { masks.seen[r * words + v / 64] &= ~(uint64_t(1) << (v % 64)); };
+  for (size_t v = 0; v < n; ++v) {
+    if (v % 7 == 0 || (v >= 1090 && v < 1120) || v >= 2400)  // no photo sees these
+      for (size_t r = 0; r < 3; ++r) clear_bit(r, v);
+    if (v % 5 == 0) clear_bit(1, v);  // photo 1 misses some more
+  }
+  GatherSettings settings;
+  settings.chunk_sample_bytes = 1100 * sizeof(Sample) * 3;  // chunks of 1100 vertices
+  PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
+  size_t chunks = 0, unseen = 0, checked = 0;
+  gather_samples(mesh.view(), rasters, lights, masks, settings, cache, [&](const SampleChunk &c) {
+    ++chunks;
+    for (uint32_t i = 0; i < c.vertex_count; ++i) {
+      const size_t v = c.first_vertex + i;
+      std::vector<size_t> expected;
+      for (size_t r = 0; r < 3; ++r)
+        if (masks.is_seen(r, v)) expected.push_back(r);
+      ASSERT_EQ(c.offsets[i + 1] - c.offsets[i], expected.size()) << "vertex " << v;
+      unseen += expected.empty();
+      for (size_t k = 0; k < expected.size(); ++k) {
+        const Sample &got = c.samples[c.offsets[i] + k];
+        Sample want;
+        make_sample(mesh.view().positions + 3 * v, mesh.view().normals + 3 * v, rasters[expected[k]],
+                    uint16_t(expected[k]), lights[expected[k]], f.photo, true, true, settings, want);
+        ASSERT_EQ(got.raster, want.raster) << "vertex " << v;
+        EXPECT_EQ(0, std::memcmp(got.rgb, want.rgb, sizeof want.rgb)) << "vertex " << v;
+        EXPECT_EQ(got.d, want.d) << "vertex " << v;
+        EXPECT_EQ(got.lobe_cos, want.lobe_cos) << "vertex " << v;
+        ++checked;
+      }
+    }
+  });
+  EXPECT_EQ(chunks, 3u);
+  EXPECT_GT(unseen, 400u);
+  EXPECT_GT(checked, 5000u);
+}
+
 TEST(Samples, MasksTellWhetherARasterSeesAChunk) {
   VisibilityMasks m;
   m.vertex_count = 200;

@@ -1244,6 +1244,28 @@ TEST_F(GlVisibilityTest, DividedCameraPassesAgreeWithTheCpu) {
   }
 }
 
+// One backend draws its shadow maps at the size each light needs, keeping a texture larger than the
+// next map and drawing into its corner (gl_depth.h ensure_render_target_region): every light,
+// whether its map grew or shrank from the previous one, gives the codes of a fresh backend's pass.
+TEST_F(GlVisibilityTest, ShadowMapsOfChangingSizeGiveTheCodesOfFreshPasses) {
+  const MeshData m = dense_scene(230, 24);
+  auto shared = gl(m);
+  std::vector<V3> order(std::begin(kLights), std::end(kLights));
+  order.insert(order.end(), std::rbegin(kLights), std::rend(kLights));
+  std::vector<int> sizes;
+  for (V3 light : order) {
+    const V3 l = normalized(light);
+    const std::vector<uint8_t> kept = run_light(*shared, m, l);
+    sizes.push_back(shared->last_pass_sizes().shadow_map);
+    auto fresh = gl(m);
+    EXPECT_EQ(kept, run_light(*fresh, m, l)) << light_label("dense", l) << ", map " << sizes.back();
+  }
+  // The order makes the map both shrink and grow between passes.
+  bool shrank = false, grew = false;
+  for (size_t i = 1; i < sizes.size(); ++i) shrank |= sizes[i] < sizes[i - 1], grew |= sizes[i] > sizes[i - 1];
+  EXPECT_TRUE(shrank && grew);
+}
+
 // Shadow maps sized per light (pass_size.h) against the former fixed size (resolved_shadow_map_size:
 // 2048 here, where the overhead light's map is ~1400) and the CPU: the sized pass meets the bound
 // of the others (<= 2 % of the vertices facing the light disagree with the CPU, nearly all within

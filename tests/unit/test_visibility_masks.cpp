@@ -64,6 +64,10 @@ TEST(VisibilityMasks, PhotosOfOneCameraShareItsPass) {
     EXPECT_EQ(0, std::memcmp(&masks.lit[r * words], one.lit.data(), words * 8)) << r;
     EXPECT_EQ(masks.footprints[r], one.footprints[0]) << r;
     EXPECT_EQ(masks.seen_count[r], one.seen_count[0]) << r;
+    // Why the others are not seen: counted again or copied with the shared pass's classification.
+    EXPECT_EQ(masks.off_image[r], one.off_image[0]) << r;
+    EXPECT_EQ(masks.back_facing[r], one.back_facing[0]) << r;
+    EXPECT_EQ(masks.occluded[r], one.occluded[0]) << r;
   }
   EXPECT_GT(masks.occluded[0], 0u);  // the sphere hides part of the grid: the codes matter
   EXPECT_GT(masks.seen_count[2], 0u);

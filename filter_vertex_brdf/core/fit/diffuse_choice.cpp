@@ -82,34 +82,45 @@ std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Rast
   gather.resolution_weights = false;
   const int folds = diffuse_pilot_folds(rasters.size());
   std::vector<PilotVertex> out;
-  std::vector<Sample> train;
   gather_samples(mesh, rasters, lights, pilot, gather, photos, [&](SampleChunk &chunk) {
     if (prepare) prepare(chunk);
-    for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
-      const Sample *begin = chunk.samples.data() + chunk.offsets[i], *end = chunk.samples.data() + chunk.offsets[i + 1];
-      if (begin == end) continue;
-      PilotVertex p;
-      p.vertex = chunk.first_vertex + i;
-      bool modelled = false;
-      for (int k = 0; k < folds; ++k) {
-        const int fold = kFoldOrder[k];
-        train.clear();
-        for (const Sample *s = begin; s != end; ++s)
-          if (!held_out(*s, fold)) train.push_back(*s);
-        VertexFit fit;
-        fit_vertex_cpu(train.data(), train.size(), phong, fit);
-        if (!has_model(fit)) continue;
-        modelled = true;
-        for (const Sample *s = begin; s != end; ++s) {
-          if (!held_out(*s, fold) || !scorable(*s)) continue;
-          float predicted[3];
-          evaluate_phong(fit, s->d, s->lobe_cos, predicted);
-          for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;
-          ++p.samples;
+    // The pilot vertices are scattered over the chunk: each is fitted on its own (in parallel),
+    // then the modelled ones are kept in vertex order.
+    std::vector<uint32_t> pilot_in_chunk;
+    for (uint32_t i = 0; i < chunk.vertex_count; ++i)
+      if (chunk.offsets[i + 1] > chunk.offsets[i]) pilot_in_chunk.push_back(i);
+    std::vector<PilotVertex> scored(pilot_in_chunk.size());
+    std::vector<uint8_t> modelled(pilot_in_chunk.size(), 0);
+#pragma omp parallel
+    {
+      std::vector<Sample> train;
+#pragma omp for schedule(dynamic, 16)
+      for (long long n = 0; n < (long long)pilot_in_chunk.size(); ++n) {
+        const uint32_t i = pilot_in_chunk[size_t(n)];
+        const Sample *begin = chunk.samples.data() + chunk.offsets[i], *end = chunk.samples.data() + chunk.offsets[i + 1];
+        PilotVertex &p = scored[size_t(n)];
+        p.vertex = chunk.first_vertex + i;
+        for (int k = 0; k < folds; ++k) {
+          const int fold = kFoldOrder[k];
+          train.clear();
+          for (const Sample *s = begin; s != end; ++s)
+            if (!held_out(*s, fold)) train.push_back(*s);
+          VertexFit fit;
+          fit_vertex_cpu(train.data(), train.size(), phong, fit);
+          if (!has_model(fit)) continue;
+          modelled[size_t(n)] = 1;
+          for (const Sample *s = begin; s != end; ++s) {
+            if (!held_out(*s, fold) || !scorable(*s)) continue;
+            float predicted[3];
+            evaluate_phong(fit, s->d, s->lobe_cos, predicted);
+            for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;
+            ++p.samples;
+          }
         }
       }
-      if (modelled) out.push_back(p);
     }
+    for (size_t n = 0; n < scored.size(); ++n)
+      if (modelled[n]) out.push_back(scored[n]);
   });
   return out;
 }

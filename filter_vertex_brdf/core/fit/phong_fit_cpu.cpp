@@ -12,12 +12,23 @@ struct FitSample {
   double p[3];
   double d, s, w;
   bool highlight;
+  double ln_s = 0;  // ln(min(s, 1)) where s > 0 (with_ln_s): the lobe's iterations need no log
 };
 
 // s^alpha without ln(0), overflow or denormals.
 inline double lobe(double s, double alpha) {
   if (!(s > 0)) return 0;
   return std::exp(std::max(alpha * std::log(std::min(s, 1.0)), -80.0));
+}
+
+// The same for a fit sample, from its stored logarithm (bit for bit the value of lobe()).
+inline double lobe(const FitSample &x, double alpha) {
+  return x.s > 0 ? std::exp(std::max(alpha * x.ln_s, -80.0)) : 0.0;
+}
+
+inline FitSample with_ln_s(FitSample x) {
+  if (x.s > 0) x.ln_s = std::log(std::min(x.s, 1.0));
+  return x;
 }
 
 struct Linear {
@@ -42,9 +53,11 @@ public:
   // Exact non-negative least squares in (rho, k_s) for a fixed alpha (ks_free = false: k_s = 0).
   Linear solve(double alpha, bool ks_free, const PhongFitOptions &o) const {
     double b = 0, g2 = 0, q[3] = {0, 0, 0};
+    lobes_.resize(samples_.size());  // kept for the energy below: one exponential per sample
     if (ks_free)
-      for (const FitSample &x : samples_) {
-        const double g = lobe(x.s, alpha);
+      for (size_t i = 0; i < samples_.size(); ++i) {
+        const FitSample &x = samples_[i];
+        const double g = lobes_[i] = lobe(x, alpha);
         b += x.w * x.d * g;
         g2 += x.w * g * g;
         for (int c = 0; c < 3; ++c) q[c] += x.w * g * x.p[c];
@@ -71,14 +84,16 @@ public:
     }
     for (int c = 0; c < 3; ++c) L.rho[c] = std::min(L.rho[c], double(o.kd_max));
     L.ks = std::min(L.ks, double(o.ks_max));
-    L.energy = energy(L, alpha);
+    L.energy = energy(L, ks_free ? lobes_.data() : nullptr);
     return L;
   }
 
-  double energy(const Linear &L, double alpha) const {
+  // The objective for L; `lobes`: s^alpha per sample (may be null when L.ks = 0).
+  double energy(const Linear &L, const double *lobes) const {
     double e = 0;
-    for (const FitSample &x : samples_) {
-      const double g = L.ks > 0 ? L.ks * lobe(x.s, alpha) : 0;
+    for (size_t i = 0; i < samples_.size(); ++i) {
+      const FitSample &x = samples_[i];
+      const double g = L.ks > 0 ? L.ks * lobes[i] : 0;
       for (int c = 0; c < 3; ++c) {
         const double r = x.p[c] - L.rho[c] * x.d - g;
         e += x.w * r * r;
@@ -94,8 +109,8 @@ public:
     grad = curv = 0;
     for (const FitSample &x : samples_) {
       if (!(x.s > 0) || x.s >= 1) continue;
-      const double g = lobe(x.s, alpha);
-      const double dg = L.ks * g * std::log(x.s) * alpha;  // d(k_s s^alpha)/dt
+      const double g = lobe(x, alpha);
+      const double dg = L.ks * g * x.ln_s * alpha;  // d(k_s s^alpha)/dt
       for (int c = 0; c < 3; ++c) {
         const double r = x.p[c] - L.rho[c] * x.d - L.ks * g;
         grad += -2 * x.w * r * dg;
@@ -109,6 +124,7 @@ private:
   double rho0_[3];
   double prior_;
   double a_ = 0, p_[3] = {0, 0, 0};
+  mutable std::vector<double> lobes_;  // s^alpha of the last solve's alpha
 };
 
 // Thesis 4.5-style initial shininess: ln(P - rho0 d) = ln k_s + alpha ln s over highlight samples.
@@ -119,7 +135,7 @@ double alpha_from_highlights(const std::vector<FitSample> &samples, const double
     if (!x.highlight || !(x.s > 0) || x.s >= 1) continue;
     const double excess = (x.p[0] + x.p[1] + x.p[2] - (rho0[0] + rho0[1] + rho0[2]) * x.d) / 3;
     if (!(excess > 1e-4)) continue;
-    const double lx = std::log(x.s), ly = std::log(excess);
+    const double lx = x.ln_s, ly = std::log(excess);
     sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly, ++n;
   }
   const double var = sxx - sx * sx / std::max(n, 1);
@@ -209,7 +225,7 @@ int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std
                 s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold)};
     (x.highlight ? w_high : w_other) += x.w;
     n_high += x.highlight;
-    samples.push_back(x);
+    samples.push_back(with_ln_s(x));
   }
   return n_high;
 }
@@ -266,7 +282,7 @@ void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool w
 
   // Scale of the data (objective of the zero model): floors below are relative to it, so that
   // the stopping rule does not depend on the photos' absolute brightness.
-  const double data_energy = problem.energy(Linear(), alpha) + 1e-300;
+  const double data_energy = problem.energy(Linear(), nullptr) + 1e-300;
   int it = 0;
   bool converged = !ks_free;
   double damping = 1e-3;

@@ -138,7 +138,8 @@ struct FitResult {
   size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;
   double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
   // The stages around those (the report's second time line): colour chart search and correction
-  // plan, photo content checks, the diffuse-form pilot, the material stage and the neighbour fill.
+  // plan (in a thread of its own during the visibility passes, so not on the wall clock's path
+  // unless it outlasts them), photo content checks, the diffuse-form pilot, the material stage and the neighbour fill.
   double seconds_colors = 0, seconds_photo_checks = 0, seconds_pilot = 0, seconds_materials = 0, seconds_fill = 0;
 };
 

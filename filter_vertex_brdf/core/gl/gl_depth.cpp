@@ -91,8 +91,8 @@ void finish_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
   check_gl_error(gl, "the allocation of the " + std::to_string(width) + "x" + std::to_string(height) +
                          " render target for " + what);
   check_framebuffer(gl, GL_FRAMEBUFFER, what);
-  t.width = width;
-  t.height = height;
+  t.width = t.allocated_width = width;
+  t.height = t.allocated_height = height;
 }
 
 void ensure_window_depth_target(const GlApi &gl, GlRenderTarget &t, int width, int height, const std::string &what) {
@@ -128,7 +128,10 @@ void window_depth_unproject(const float projection[16], float out[4]) {
 
 void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
                           const std::string &who, const std::string &what) {
-  if (t.fbo && t.width == width && t.height == height) return;
+  if (t.fbo && t.allocated_width == width && t.allocated_height == height) {
+    t.width = width, t.height = height;
+    return;
+  }
   check_gl_target_size(gl, width, height, who, what);
   if (kind == RenderTargetKind::WindowDepth) {
     ensure_window_depth_target(gl, t, width, height, what);
@@ -154,6 +157,16 @@ void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
   gl.DrawBuffers(shading ? 2 : 1, buffers);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   finish_render_target(gl, t, width, height, what);
+}
+
+void ensure_render_target_region(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
+                                 const std::string &who, const std::string &what) {
+  if (t.fbo && t.allocated_width >= width && t.allocated_height >= height) {
+    check_gl_target_size(gl, width, height, who, what);
+    t.width = width, t.height = height;
+    return;
+  }
+  ensure_render_target(gl, t, width, height, kind, who, what);
 }
 
 void release_render_target(const GlApi &gl, GlRenderTarget &t) {

@@ -45,7 +45,8 @@ GlMeshFrame gl_mesh_frame(const MeshView &mesh, float depth_tolerance_fraction, 
 // Names are GL object names (GLuint); 0 = not allocated.
 struct GlRenderTarget {
   unsigned fbo = 0, color = 0, extra = 0, depth = 0;
-  int width = 0, height = 0;
+  int width = 0, height = 0;                      // the size in use (passes draw and read this much)
+  int allocated_width = 0, allocated_height = 0;  // the size of the GL objects (>= the size in use)
 };
 enum class RenderTargetKind { LinearDepth, ShadingAndDepth, WindowDepth };
 
@@ -62,6 +63,13 @@ void window_depth_unproject(const float projection[16], float out[4]);
 // Throws ProcessingError naming `what` when GL cannot allocate or complete it.
 void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
                           const std::string &who, const std::string &what);
+// The same, but a target already allocated at least that large is kept and only its lower-left
+// width x height region used (t.width, t.height): for passes whose size changes from one to the
+// next (the shadow maps, sized per light), which would otherwise allocate, and the driver clear,
+// a new texture each time (llvmpipe: 64 MB per 4096² pass). Only for users that address texels
+// (texelFetch), not normalised coordinates.
+void ensure_render_target_region(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
+                                 const std::string &who, const std::string &what);
 // Deletes the GL objects of `t` (the context must be current) and resets it.
 void release_render_target(const GlApi &gl, GlRenderTarget &t);
 

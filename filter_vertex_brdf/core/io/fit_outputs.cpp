@@ -209,7 +209,8 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
       << g.host_photo_reads << " photos read from MeshLab's images, "
       << g.rasters_skipped << " raster x chunk pairs skipped)\n";
-  rep << "time, other stages: colour chart search and correction " << fixed(r.seconds_colors) << " s, photo checks "
+  rep << "time, other stages: colour chart search and correction " << fixed(r.seconds_colors)
+      << " s (beside the visibility passes), photo checks "
       << fixed(r.seconds_photo_checks) << " s, diffuse-form pilot " << fixed(r.seconds_pilot) << " s, materials "
       << fixed(r.seconds_materials) << " s, neighbour fill " << fixed(r.seconds_fill) << " s\n";
   return rep.str();

@@ -150,10 +150,11 @@ void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &ve
 // A partial footprint gives kRimFootprint and the own texels' colour when
 // settings.own_surface_texels and any own texel remains, else kMixedPixel and the plain bilinear
 // colour. Returns the flags; when the result has any kNotSeen flag, `out` holds only flags and
-// geometry terms.
+// geometry terms. `projected`: project_to_image(raster.shot, position) when the caller has it.
 uint16_t make_sample(const float position[3], const float normal[3], const Raster &raster, uint16_t raster_index,
                      const LightSource &light, const Photo &photo, bool camera_clear, bool light_clear,
-                     const GatherSettings &settings, Sample &out, uint8_t own_texels = kAllFootprintTexels);
+                     const GatherSettings &settings, Sample &out, uint8_t own_texels = kAllFootprintTexels,
+                     const ImagePoint *projected = nullptr);
 
 struct SampleChunk {
   uint32_t first_vertex = 0;

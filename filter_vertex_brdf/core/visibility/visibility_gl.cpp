@@ -423,7 +423,7 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
     // A directional light's orthographic window depth is linear in the view depth and keeps
     // float precision over the bounding sphere; point lights keep the linear-depth output.
     if (test_program_ && depth_only_program_ && !lv.perspective) {
-      ensure_render_target(gl_, light_window_target_, size, size, RenderTargetKind::WindowDepth, kWho,
+      ensure_render_target_region(gl_, light_window_target_, size, size, RenderTargetKind::WindowDepth, kWho,
                            "the light-view shadow map");
       render_depth(light_window_target_, view, projection, "the light-view shadow map pass", true);
       TestPass pass;
@@ -435,7 +435,8 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
       test_on_gpu(light_window_target_, pass, out, "the shadow tests");
       return;
     }
-    ensure_render_target(gl_, light_target_, size, size, RenderTargetKind::LinearDepth, kWho, "the light-view shadow map");
+    ensure_render_target_region(gl_, light_target_, size, size, RenderTargetKind::LinearDepth, kWho,
+                                "the light-view shadow map");
     render_depth(light_target_, view, projection, "the light-view shadow map pass");
     if (test_program_) {
       TestPass pass;
