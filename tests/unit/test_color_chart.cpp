@@ -188,6 +188,34 @@ TEST(ChartCorrection, TooFewUsablePatchesIsAnError) {
   EXPECT_THROW(fit_color_correction(ref, ref, usable), ProcessingError);
 }
 
+// The detector's 8-bit image taken from an 8-bit sRGB photo's own codes (photo_srgb8_bgr, the
+// fit's chart search) is the image the linear round trip gives, for every code in every channel
+// and for the channel orders a Photo may have (OpenCV's BGR, a host's RGBA, grey); 16-bit and
+// linear-encoded photos have none (the search then converts them as before).
+TEST(ChartDetection, EightBitPhotosGiveTheDetectorTheirOwnCodes) {
+  const std::vector<std::pair<int, std::array<int, 3>>> layouts = {{3, {{2, 1, 0}}}, {4, {{0, 1, 2}}}, {1, {{0, 0, 0}}}};
+  for (const auto &layout : layouts) {
+    const int n = layout.first;
+    cv::Mat codes(3, 256, CV_8UC(n));
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 256; ++x)
+        for (int c = 0; c < n; ++c) codes.ptr<uint8_t>(y)[n * x + c] = uint8_t((x + 85 * (c + y)) % 256);
+    HostPixels host;
+    host.pixels = codes;
+    host.rgb = layout.second;
+    const Photo photo = photo_from_host("codes.png", host, PhotoEncoding::SRGB);
+    const cv::Mat direct = photo_srgb8_bgr(photo), round_trip = srgb8_bgr_image(photo_linear_rgb(photo));
+    ASSERT_EQ(direct.type(), CV_8UC3) << n << " channels";
+    EXPECT_EQ(cv::norm(direct, round_trip, cv::NORM_INF), 0.0) << n << " channels";
+    EXPECT_GT(cv::norm(direct, cv::NORM_INF), 250.0);  // every code is there
+    if (n == 3) EXPECT_EQ(direct.at<cv::Vec3b>(0, 7), cv::Vec3b(codes.at<cv::Vec3b>(0, 7)));  // BGR in, BGR out
+    EXPECT_TRUE(photo_srgb8_bgr(photo_from_host("codes.png", host, PhotoEncoding::Linear)).empty());
+  }
+  HostPixels wide;
+  wide.pixels = cv::Mat(2, 2, CV_16UC3, cv::Scalar(1000, 2000, 3000));
+  EXPECT_TRUE(photo_srgb8_bgr(photo_from_host("wide.png", wide, PhotoEncoding::Auto)).empty());
+}
+
 TEST(ChartDetection, EncodingForTheDetectorRoundsAsTheSrgbCurve) {
   // srgb8_bgr_image's table must give the codes of rounding 255 * linear_to_srgb(v) to the nearest
   // integer (floor(x + 0.5); saturate_cast would round x + 0.5 once more, one code too high for

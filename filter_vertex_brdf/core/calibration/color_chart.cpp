@@ -221,8 +221,8 @@ double leave_one_out(Fitter fit, const std::vector<int> &idx, const PatchColors 
 // ---- calibration steps ----
 
 // Tries the detector on up to `tries` evenly spaced photos; keeps the lowest-cost detection.
-bool locate_chart(size_t count, const RgbLoader &load, const ColorSettings &s, const std::vector<std::string> &names,
-                  ChartLocation &chart, std::vector<std::string> &log) {
+bool locate_chart(size_t count, const RgbLoader &load, const RgbLoader &detector_image, const ColorSettings &s,
+                  const std::vector<std::string> &names, ChartLocation &chart, std::vector<std::string> &log) {
   if (s.manual) {
     chart = chart_from_corners(s.corners);
     log.push_back("ColorChecker: corner patches given by the user.");
@@ -266,10 +266,14 @@ bool locate_chart(size_t count, const RgbLoader &load, const ColorSettings &s, c
   };
   for (size_t t = 0; t < tries; ++t) {  // the loader is not assumed to be thread-safe
     const size_t i = tries > 1 ? t * (count - 1) / (tries - 1) : 0;
-    const cv::Mat img = load(i);
-    if (img.empty()) continue;
+    cv::Mat bgr8 = detector_image ? detector_image(i) : cv::Mat();
+    if (bgr8.empty()) {
+      const cv::Mat img = load(i);
+      if (img.empty()) continue;
+      bgr8 = srgb8_bgr_image(img);
+    }
     photo.push_back(i);
-    bgr.push_back(srgb8_bgr_image(img));
+    bgr.push_back(bgr8);
     if (bgr.size() >= batch || std::max(bgr.back().cols, bgr.back().rows) > kDetectSide) search_pending();
   }
   search_pending();
@@ -710,12 +714,12 @@ CorrectionFit fit_color_correction(const PatchColors &measured, const PatchColor
 
 ColorCalibration calibrate_colors(size_t count, const RgbLoader &load, const ColorSettings &s,
                                   const std::vector<std::array<double, 3>> *lights,
-                                  const std::vector<std::string> &names) {
+                                  const std::vector<std::string> &names, const RgbLoader &detector_image) {
   ColorCalibration cal;
   cal.divisor.assign(count, 1.0);
   const PatchColors &ref = s.reference ? *s.reference : colorchecker_classic_reference();
   if (count == 0) return cal;
-  if (!locate_chart(count, load, s, names, cal.chart, cal.log)) {
+  if (!locate_chart(count, load, detector_image, s, names, cal.chart, cal.log)) {
     const std::string msg = "No ColorChecker found in the photos of this viewpoint";
     if (s.require_chart)
       throw InputError(msg + " and colour correction is required: give the centres of the chart's corner patches "

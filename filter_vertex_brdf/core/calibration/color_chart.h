@@ -149,9 +149,12 @@ using RgbLoader = std::function<cv::Mat(size_t index)>;
 // serves all photos, otherwise each photo is normalised by E = b / (n . L). Without lights, Auto
 // does not normalise (On normalises by the neutral patches alone). No chart: returns
 // corrected == false with a log line, or throws InputError when settings.require_chart.
+// `detector_image` (optional): photo `index` as the 8-bit sRGB BGR image the detector searches,
+// where the caller has it cheaper than from `load` (inputs/photo.h photo_srgb8_bgr); an empty
+// image (or no function) means srgb8_bgr_image(load(index)).
 ColorCalibration calibrate_colors(size_t photo_count, const RgbLoader &load, const ColorSettings &settings,
                                   const std::vector<std::array<double, 3>> *lights = nullptr,
-                                  const std::vector<std::string> &names = {});
+                                  const std::vector<std::string> &names = {}, const RgbLoader &detector_image = {});
 
 // Corrects one linear RGB triple of photo `photo` in place (no-op when !corrected).
 void apply_color_calibration(const ColorCalibration &cal, size_t photo, float rgb[3]);

@@ -72,7 +72,11 @@ ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
     const Raster &raster = input.rasters[r];
     return photo_linear_rgb(*photos.get(raster.image_path, raster.width(), raster.height()));
   };
-  return plan_color_correction(input.rasters, lights_world, cs, load, log);
+  const auto detector_image = [&](size_t r) {  // 8-bit sRGB photos: their own codes, no float copy
+    const Raster &raster = input.rasters[r];
+    return photo_srgb8_bgr(*photos.get(raster.image_path, raster.width(), raster.height()));
+  };
+  return plan_color_correction(input.rasters, lights_world, cs, load, log, detector_image);
 }
 
 // The colour plan, searched in a thread of its own while the GL passes run: it needs the photos

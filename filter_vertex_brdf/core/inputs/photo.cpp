@@ -154,6 +154,20 @@ cv::Mat photo_linear_rgb(const Photo &photo, cv::Mat *clipped) {
   return linear;
 }
 
+cv::Mat photo_srgb8_bgr(const Photo &photo) {
+  if (photo.linear || photo.pixels.depth() != CV_8U || photo.pixels.empty()) return cv::Mat();
+  const int w = photo.width(), h = photo.height(), n = photo.pixels.channels();
+  cv::Mat bgr(h, w, CV_8UC3);
+#pragma omp parallel for schedule(static)
+  for (int y = 0; y < h; ++y) {
+    const uint8_t *in = photo.pixels.ptr<uint8_t>(y);
+    uint8_t *out = bgr.ptr<uint8_t>(y);
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) out[3 * x + 2 - c] = in[n * x + photo.rgb[size_t(c)]];
+  }
+  return bgr;
+}
+
 cv::Mat decode_to_linear(const cv::Mat &image, bool decode_srgb) {
   if (image.empty()) return cv::Mat();
   cv::Mat f;
