@@ -338,6 +338,49 @@ TEST(ChartCalibration, TwoChartsUseTheLargerOneAndSaySo) {
   EXPECT_LT(c.fit.after, 1.0);
 }
 
+// Measuring the chart on the chart's part of each photo (the fit's load_region: no float copy of
+// the whole photo) gives the very numbers the whole photos give, for a chart inside the frame and
+// one cut by its right and bottom edges (patches off the photo unusable either way).
+TEST(ChartCalibration, ChartRegionsMeasureAsTheWholePhotos) {
+  const std::array<cv::Point2f, 4> cut = {{{300, 250}, {700, 270}, {690, 540}, {290, 520}}};
+  for (const auto &quad : {kQuad, cut}) {
+    std::vector<cv::Mat> photos;
+    for (int p = 0; p < 4; ++p) {
+      cv::Mat img = background(640, 480, unsigned(30 + p));
+      draw_chart(img, quad, 0.5 + 0.15 * p);
+      for (int y = 0; y < img.rows; ++y)  // a pixel-scale texture: a shifted sampling would show
+        for (int x = 0; x < img.cols; ++x) img.at<cv::Vec3f>(y, x) *= 1.0f + 0.02f * float((7 * x + 13 * y) % 5);
+      photos.push_back(img);
+    }
+    ColorSettings s;
+    s.manual = true;  // the cut chart is given by hand, as a user would
+    const auto centres = corner_patch_centres(quad);
+    for (int k = 0; k < 4; ++k) s.corners[2 * k] = centres[size_t(k)].x, s.corners[2 * k + 1] = centres[size_t(k)].y;
+    std::vector<cv::Rect> asked;
+    const RgbLoader whole = [&](size_t i) { return photos[i]; };
+    const RgbRegionLoader part = [&](size_t i, const cv::Rect &r) {
+      asked.push_back(r);
+      return cv::Mat(photos[i](r & cv::Rect(0, 0, photos[i].cols, photos[i].rows))).clone();
+    };
+    const ColorCalibration a = calibrate_colors(photos.size(), whole, s);
+    const ColorCalibration b = calibrate_colors(photos.size(), whole, s, nullptr, {}, {}, part);
+    ASSERT_EQ(a.patches.size(), photos.size());
+    ASSERT_EQ(b.patches.size(), photos.size());
+    ASSERT_EQ(asked.size(), photos.size());
+    EXPECT_LT(asked[0].area(), 640 * 480 * 3 / 4);  // a part, not the photo
+    int usable = 0;
+    for (size_t p = 0; p < photos.size(); ++p)
+      for (int k = 0; k < kChartPatches; ++k) {
+        EXPECT_EQ(a.patches[p].usable[k], b.patches[p].usable[k]) << p << " " << k;
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(a.patches[p].rgb[k][c], b.patches[p].rgb[k][c]) << p << " " << k;
+        usable += a.patches[p].usable[k];
+      }
+    EXPECT_GT(usable, 20);
+    if (quad == cut) EXPECT_LT(usable, 4 * kChartPatches);  // the cut chart loses patches
+    EXPECT_EQ(a.corrected, b.corrected);
+  }
+}
+
 TEST(ChartCalibration, ConstantAndVaryingLightIntensity) {
   // Eight photos of a chart facing n under lights L_p spread as in an RTI capture (20 to 70 deg
   // from the chart's normal); the chart's brightness is E_p (n . L_p). With a hand-held flash E_p

@@ -600,7 +600,24 @@ std::vector<ChartLocation> detect_charts(const cv::Mat &bgr8, int max_charts, st
   return out;
 }
 
-PatchMeasurement measure_chart(const cv::Mat &img, const ChartLocation &chart) {
+namespace {
+// The pixels measure_chart reads: the chart's grid (corner patch centres at 0..5 x 0..3, patches
+// +-0.5 around them) mapped into the photo, 2 pixels wider for the bilinear footprints, x, y >= 0.
+cv::Rect chart_region(const ChartLocation &chart) {
+  const cv::Matx33d h = grid_to_image(chart);
+  double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
+  for (const cv::Point2d g : {cv::Point2d(-0.5, -0.5), cv::Point2d(5.5, -0.5), cv::Point2d(5.5, 3.5), cv::Point2d(-0.5, 3.5)}) {
+    const cv::Point2d p = map_point(h, g.x, g.y);
+    x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+  }
+  if (!(x1 > x0 && y1 > y0 && x1 - x0 < 1e6 && y1 - y0 < 1e6)) return cv::Rect();  // degenerate: whole photo
+  const int left = std::max(0, int(std::floor(x0)) - 2), top = std::max(0, int(std::floor(y0)) - 2);
+  return cv::Rect(left, top, std::max(1, int(std::ceil(x1)) + 3 - left), std::max(1, int(std::ceil(y1)) + 3 - top));
+}
+
+// measure_chart on `img`, whose pixel (0, 0) is the photo's pixel `origin` (integer offsets keep
+// every sampling position and weight exactly those of the whole photo).
+PatchMeasurement measure_chart_at(const cv::Mat &img, const ChartLocation &chart, cv::Point origin) {
   CV_Assert(img.type() == CV_32FC3);
   PatchMeasurement m;
   const cv::Matx33d h = grid_to_image(chart);
@@ -614,7 +631,7 @@ PatchMeasurement measure_chart(const cv::Mat &img, const ChartLocation &chart) {
       for (int b = 0; b < n; ++b) {
         const cv::Point2d p = map_point(h, cx - 0.3 + 0.6 * (b + 0.5) / n, cy - 0.3 + 0.6 * (a + 0.5) / n);
         cv::Vec3f v;
-        if (!sample_rgb(img, p.x, p.y, v)) {
+        if (!sample_rgb(img, p.x - origin.x, p.y - origin.y, v)) {
           inside = false;
           break;
         }
@@ -635,6 +652,11 @@ PatchMeasurement measure_chart(const cv::Mat &img, const ChartLocation &chart) {
     m.usable[k] = m.clipped[k] < 0.02f && luminance(m.rgb[k].data()) > 1e-3;
   }
   return m;
+}
+} // namespace
+
+PatchMeasurement measure_chart(const cv::Mat &img, const ChartLocation &chart) {
+  return measure_chart_at(img, chart, cv::Point(0, 0));
 }
 
 const char *correction_model_name(CorrectionModel m) {
@@ -714,7 +736,8 @@ CorrectionFit fit_color_correction(const PatchColors &measured, const PatchColor
 
 ColorCalibration calibrate_colors(size_t count, const RgbLoader &load, const ColorSettings &s,
                                   const std::vector<std::array<double, 3>> *lights,
-                                  const std::vector<std::string> &names, const RgbLoader &detector_image) {
+                                  const std::vector<std::string> &names, const RgbLoader &detector_image,
+                                  const RgbRegionLoader &load_region) {
   ColorCalibration cal;
   cal.divisor.assign(count, 1.0);
   const PatchColors &ref = s.reference ? *s.reference : colorchecker_classic_reference();
@@ -728,9 +751,10 @@ ColorCalibration calibrate_colors(size_t count, const RgbLoader &load, const Col
     cal.log.push_back(msg + ": the samples are NOT colour-corrected.");
     return cal;
   }
+  const cv::Rect region = load_region ? chart_region(cal.chart) : cv::Rect();
   for (size_t i = 0; i < count; ++i) {
-    const cv::Mat img = load(i);
-    cal.patches.push_back(img.empty() ? PatchMeasurement{} : measure_chart(img, cal.chart));
+    const cv::Mat img = region.empty() ? load(i) : load_region(i, region);
+    cal.patches.push_back(img.empty() ? PatchMeasurement{} : measure_chart_at(img, cal.chart, region.tl()));
   }
   const std::vector<double> b = chart_brightness(cal.patches, ref);
   for (size_t i = 0; i < count; ++i)

@@ -46,7 +46,8 @@ const ColorCalibration *ColorPlan::of_raster(size_t r) const {
 ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
                                 const std::vector<std::array<float, 3>> &lights_world,
                                 const ColorCorrectionSettings &settings, const std::function<cv::Mat(size_t)> &load,
-                                const LogFn &log, const std::function<cv::Mat(size_t)> &detector_image) {
+                                const LogFn &log, const std::function<cv::Mat(size_t)> &detector_image,
+                                const RgbRegionLoader &load_region) {
   ColorPlan plan;
   if (settings.choice == ColorCorrectionChoice::Off) return plan;
   const std::vector<std::vector<size_t>> groups = rasters_by_viewpoint(rasters);
@@ -66,9 +67,11 @@ ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
     const RgbLoader load_photo = [&](size_t i) { return load(group[i]); };
     RgbLoader detector_photo;
     if (detector_image) detector_photo = [&](size_t i) { return detector_image(group[i]); };
+    RgbRegionLoader region_of_photo;
+    if (load_region) region_of_photo = [&](size_t i, const cv::Rect &r) { return load_region(group[i], r); };
     try {
       plan.viewpoints.push_back(calibrate_colors(group.size(), load_photo, chart_settings_for(settings, v, groups.size()),
-                                                 &lights_cam, names, detector_photo));
+                                                 &lights_cam, names, detector_photo, region_of_photo));
     } catch (const InputError &e) {
       throw InputError("Colour correction is required (colorCorrection = Required) but failed. " + where + ": " +
                        e.what() + " Set 'chartCorners', or set 'colorCorrection' to Auto to go on without correction.");

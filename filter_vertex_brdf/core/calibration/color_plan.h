@@ -41,12 +41,13 @@ struct ColorPlan {
 // chart's shading tells varying intensity). Each viewpoint's log lines go to `log`, prefixed with
 // "Viewpoint i of n (k photo(s), first raster '...')". Throws InputError when the correction is
 // Required and a viewpoint has no usable chart, or when chart_corners has a wrong count (naming
-// 'chartCorners'). `detector_image` (optional, by raster): calibrate_colors' 8-bit image for
-// the chart detector.
+// 'chartCorners'). `detector_image` and `load_region` (optional, by raster): calibrate_colors'
+// cheaper ways to the detector's 8-bit image and to the chart's part of a photo.
 ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
                                 const std::vector<std::array<float, 3>> &lights_world,
                                 const ColorCorrectionSettings &settings, const std::function<cv::Mat(size_t)> &load,
-                                const LogFn &log, const std::function<cv::Mat(size_t)> &detector_image = {});
+                                const LogFn &log, const std::function<cv::Mat(size_t)> &detector_image = {},
+                                const RgbRegionLoader &load_region = {});
 
 // In place: corrected = M(rgb / exposure) for every sample of a corrected viewpoint. Negative
 // results (a matrix applied to noise in dark pixels) are no light, and NaN is none: both become 0.

@@ -76,7 +76,15 @@ ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
     const Raster &raster = input.rasters[r];
     return photo_srgb8_bgr(*photos.get(raster.image_path, raster.width(), raster.height()));
   };
-  return plan_color_correction(input.rasters, lights_world, cs, load, log, detector_image);
+  const auto load_region = [&](size_t r, const cv::Rect &region) {  // the chart's part of a photo only
+    const Raster &raster = input.rasters[r];
+    Photo part = *photos.get(raster.image_path, raster.width(), raster.height());
+    const cv::Rect inside = region & cv::Rect(0, 0, part.width(), part.height());
+    if (inside.empty() || inside.tl() != region.tl()) return cv::Mat();
+    part.pixels = part.pixels(inside);  // a header on the same pixels
+    return photo_linear_rgb(part);
+  };
+  return plan_color_correction(input.rasters, lights_world, cs, load, log, detector_image, load_region);
 }
 
 // The colour plan, searched in a thread of its own while the GL passes run: it needs the photos
