@@ -1,13 +1,13 @@
 #include "fit/pipeline.h"
 
 #include <algorithm>
-#include <exception>
-#include <future>
-
-#include <omp.h>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <future>
 #include <sstream>
+
+#include <omp.h>
 
 #include "base/errors.h"
 #include "base/file_util.h"
@@ -89,8 +89,8 @@ ColorPlan plan_colors(const FitInput &input, const FitSettings &settings,
 
 // The colour plan, searched in a thread of its own while the GL passes run: it needs the photos
 // only, and on a software renderer the passes leave a core idle between their draws (100 k x 32
-// on llvmpipe: end to end 0.94x, the search's 0.25-0.4 s hidden). It leaves one core to the
-// passes. Its log lines are kept and written, in order, by take().
+// on llvmpipe: end to end 0.97x in turn, the search's 0.25-0.4 s hidden). It leaves one core to
+// the passes. Its log lines are kept and written, in order, by take().
 class ColorPlanBesidePasses {
 public:
   ColorPlanBesidePasses(const FitInput &input, const FitSettings &settings,
