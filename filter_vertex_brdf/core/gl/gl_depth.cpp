@@ -161,8 +161,7 @@ void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
 
 void ensure_render_target_region(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
                                  const std::string &who, const std::string &what) {
-  if (t.fbo && t.allocated_width >= width && t.allocated_height >= height) {
-    check_gl_target_size(gl, width, height, who, what);
+  if (t.fbo && t.allocated_width >= width && t.allocated_height >= height) {  // within a size GL allocated
     t.width = width, t.height = height;
     return;
   }

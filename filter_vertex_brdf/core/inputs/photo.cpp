@@ -156,15 +156,9 @@ cv::Mat photo_linear_rgb(const Photo &photo, cv::Mat *clipped) {
 
 cv::Mat photo_srgb8_bgr(const Photo &photo) {
   if (photo.linear || photo.pixels.depth() != CV_8U || photo.pixels.empty()) return cv::Mat();
-  const int w = photo.width(), h = photo.height(), n = photo.pixels.channels();
-  cv::Mat bgr(h, w, CV_8UC3);
-#pragma omp parallel for schedule(static)
-  for (int y = 0; y < h; ++y) {
-    const uint8_t *in = photo.pixels.ptr<uint8_t>(y);
-    uint8_t *out = bgr.ptr<uint8_t>(y);
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) out[3 * x + 2 - c] = in[n * x + photo.rgb[size_t(c)]];
-  }
+  cv::Mat bgr(photo.height(), photo.width(), CV_8UC3);
+  const int from_to[6] = {photo.rgb[2], 0, photo.rgb[1], 1, photo.rgb[0], 2};  // B, G, R wherever they sit
+  cv::mixChannels(&photo.pixels, 1, &bgr, 1, from_to, 3);
   return bgr;
 }
 

@@ -88,6 +88,11 @@ void classify_seen(const MeshView &mesh, const Raster &raster, const std::vector
   counts[0] = uint32_t(off), counts[1] = uint32_t(back), counts[2] = uint32_t(occ), counts[3] = uint32_t(seen);
 }
 
+// Photos of one camera (same shot and size) see the same vertices at the same image points.
+bool same_view(const Raster &a, const Raster &b) {
+  return same_shot(a.shot, b.shot) && a.width() == b.width() && a.height() == b.height();
+}
+
 // The vertices of [first, first + count) that at least one photo sees, as offsets from `first`,
 // in order.
 std::vector<uint32_t> seen_by_any(const VisibilityMasks &masks, size_t first, size_t count) {
@@ -145,10 +150,9 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
       new_camera = true;
     }
     // What the camera sees depends on its shot and photo size only: a photo of the previous
-    // photo's camera copies its classification. Besides the projections this saves, no OpenMP
-    // region then runs between two shadow passes, whose idle-spinning worker took a core from
-    // the software renderer (visibility of 100 k x 32 on llvmpipe: 1.39-1.49 s, passive 1.04-1.19 s).
-    if (!new_camera && rasters[r].width() == rasters[r - 1].width() && rasters[r].height() == rasters[r - 1].height()) {
+    // photo's camera copies its classification (no projection of every vertex again, and no
+    // OpenMP region, whose idle workers spin, between two shadow passes).
+    if (!new_camera && same_view(rasters[r], rasters[r - 1])) {
       std::copy_n(&masks.seen[(r - 1) * words], words, &masks.seen[r * words]);
       std::copy_n(&masks.mixed[(r - 1) * words], words, &masks.mixed[r * words]);
       masks.off_image[r] = masks.off_image[r - 1], masks.back_facing[r] = masks.back_facing[r - 1];
@@ -291,8 +295,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
       }
       const auto photo = photos.get(raster.image_path, raster.width(), raster.height());
       const LightSource &light = lights[r];
-      if (!projected_for || !same_shot(projected_for->shot, raster.shot) || projected_for->width() != raster.width() ||
-          projected_for->height() != raster.height()) {
+      if (!projected_for || !same_view(*projected_for, raster)) {
         projected.resize(active.size());
 #pragma omp parallel for schedule(static)
         for (long long a = 0; a < (long long)active.size(); ++a)
