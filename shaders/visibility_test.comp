@@ -16,6 +16,10 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Positions { float positions[]; };  // x y z per vertex, origin-relative
 layout(std430, binding = 1) writeonly buffer Codes { uint codes[]; };
+// Light pass with u_only != 0: bit v % 32 of only[v / 32] marks the vertices to test (those a
+// photo sees: VisibilityBackend::light_pass's `only`); the others get 1 untested.
+layout(std430, binding = 2) readonly buffer Only { uint only[]; };
+uniform int u_only;
 
 uniform uint u_vertex_count;
 uniform uint u_first_word;       // words (groups of 4 vertices) before this dispatch
@@ -110,6 +114,10 @@ void main() {
   for (uint k = 0u; k < 4u; ++k) {
     uint v = first + k;
     if (v >= u_vertex_count) break;
+    if (u_light_pass != 0 && u_only != 0 && ((only[v / 32u] >> (v % 32u)) & 1u) == 0u) {
+      bytes |= 1u << (8u * k);
+      continue;
+    }
     vec3 p = vec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
     uint code = u_light_pass != 0 ? light_code(p) : camera_code(p);
     bytes |= code << (8u * k);

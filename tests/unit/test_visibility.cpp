@@ -1294,5 +1294,38 @@ TEST_F(GlVisibilityTest, SizedShadowMapsAgreeWithTheCpu) {
   EXPECT_LE(diff, p.size() / 50);
 }
 
+// light_pass's `only`: the wanted vertices get the codes of a full pass, the others 1 untested,
+// in the compute-shader, read-back and CPU back ends, for a directional and a point light.
+TEST_F(GlVisibilityTest, LightPassesTestOnlyTheWantedVertices) {
+  const MeshData m = dense_scene(120, 24);
+  const size_t n = vertex_count(m);
+  std::vector<uint64_t> only((n + 63) / 64, 0);
+  std::mt19937 rng(7);
+  for (size_t v = 0; v < n; ++v)
+    if (rng() % 2) only[v / 64] |= uint64_t(1) << (v % 64);
+  VisibilitySettings readback_settings;
+  readback_settings.depth_tests_on_gpu = false;
+  auto compute = gl(m), readback = gl(m, readback_settings);
+  auto cpu = make_cpu_visibility(m.view(), VisibilitySettings());
+  LightSource point;
+  point.positional = true;
+  point.position = {{0.2f, -0.3f, 2.2f}};
+  const V3 dir = normalized(kLights[1]);
+  for (VisibilityBackend *b : {compute.get(), readback.get(), cpu.get()})
+    for (const LightSource &light : {LightSource::directional({{float(dir.x), float(dir.y), float(dir.z)}}), point}) {
+      std::vector<uint8_t> full(n, 7), part(n, 7);
+      b->light_pass(light, full.data());
+      b->light_pass(light, part.data(), only.data());
+      size_t shadowed_unwanted = 0, wrong = 0;
+      for (size_t v = 0; v < n; ++v) {
+        const bool wanted = (only[v / 64] >> (v % 64)) & 1u;
+        wrong += wanted ? part[v] != full[v] : part[v] != 1;
+        shadowed_unwanted += !wanted && full[v] == 0;
+      }
+      EXPECT_EQ(wrong, 0u) << b->name() << (light.positional ? ", point light" : ", directional light");
+      EXPECT_GT(shadowed_unwanted, 10u) << b->name();  // the untested vertices would have read 0
+    }
+}
+
 } // namespace
 } // namespace vbrdf

@@ -23,9 +23,9 @@ public:
     ++camera_calls;
     inner_->camera_pass(shot, out);
   }
-  void light_pass(const LightSource &light, uint8_t *out) override {
+  void light_pass(const LightSource &light, uint8_t *out, const uint64_t *only) override {
     ++light_calls;
-    inner_->light_pass(light, out);
+    inner_->light_pass(light, out, only);
   }
   int camera_calls = 0, light_calls = 0;
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "base/errors.h"
 #include "base/vec3.h"
@@ -167,7 +168,8 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
     }
     if (masks.seen_count[r] == 0) continue;  // a photo that sees nothing needs no shadow pass
     std::fill(buffer.begin(), buffer.end(), 0);
-    backend.light_pass(lights[r], buffer.data());
+    // Shadow tests for the vertices this photo sees only (the others' lit bits are never read).
+    backend.light_pass(lights[r], buffer.data(), &masks.seen[r * words]);
     pack_bits(buffer, &masks.lit[r * words]);
   }
   report(progress, 1.0f, "visibility");
@@ -250,6 +252,46 @@ float photo_resolution(const Raster &raster, const float position[3], const floa
   return f * f / dist2 * ne;
 }
 
+namespace {
+// The samples of each active vertex, in its slots [slot_begin[a], slot_begin[a + 1]): drops those
+// that make_sample found not seen (moved to the front of the range, raster order kept; kept[a] =
+// how many stay), sets each kept sample's resolution code against the vertex's best photo (0 for
+// all without `resolution_weights`), and adds the kept samples' flags and photos to `stats`.
+void finish_vertex_samples(std::vector<Sample> &samples, const std::vector<uint32_t> &slot_begin,
+                           std::vector<uint32_t> &kept, const std::vector<Raster> &rasters, const MeshView &mesh,
+                           size_t first, const std::vector<uint32_t> &active, bool resolution_weights,
+                           GatherStats &stats) {
+#pragma omp parallel
+  {
+    uint64_t flag_counts[16] = {};
+    std::vector<uint32_t> seen_vertices(rasters.size(), 0);
+    std::vector<float> resolution(rasters.size(), 0.0f);
+#pragma omp for schedule(dynamic, 1024)
+    for (long long a = 0; a < (long long)active.size(); ++a) {
+      Sample *begin = samples.data() + slot_begin[size_t(a)], *end = samples.data() + slot_begin[size_t(a) + 1];
+      Sample *last = std::remove_if(begin, end, [](const Sample &s) { return (s.flags & kNotSeen) != 0; });
+      kept[size_t(a)] = uint32_t(last - begin);
+      const size_t v = first + active[size_t(a)];
+      float best = 0;
+      if (resolution_weights)
+        for (const Sample *s = begin; s != last; ++s)
+          best = std::max(best, resolution[s->raster] = photo_resolution(rasters[s->raster], mesh.positions + 3 * v,
+                                                                           mesh.normals + 3 * v));
+      for (Sample *s = begin; s != last; ++s) {
+        for (uint16_t f = s->flags; f; f &= uint16_t(f - 1)) ++flag_counts[bit_index(uint16_t(f & -f))];
+        s->resolution = best > 0 ? resolution_code(resolution[s->raster] / best) : 0;
+        ++seen_vertices[s->raster];
+      }
+    }
+#pragma omp critical(vbrdf_gather_stats)
+    {
+      for (int b = 0; b < 16; ++b) stats.flag_counts[b] += flag_counts[b];
+      for (size_t r = 0; r < rasters.size(); ++r) stats.raster_seen_vertices[r] += seen_vertices[r];
+    }
+  }
+}
+} // namespace
+
 GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rasters,
                            const std::vector<LightSource> &lights, const VisibilityMasks &masks,
                            const GatherSettings &settings, PhotoCache &photos,
@@ -267,11 +309,13 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     return settings.diffuse.at(v) == DiffuseForm::Coated ? as_coated : as_lambert;
   };
   const size_t raster_count = std::max<size_t>(rasters.size(), 1);
-  // A chunk holds a dense vertices x rasters block before compaction: size it to the budget.
+  // Chunks are sized as a dense vertices x rasters block of samples would fit the budget (the
+  // samples stored are at most that).
   const size_t chunk_vertices = std::max<size_t>(
       1024, settings.chunk_sample_bytes / (sizeof(Sample) * raster_count));
-  std::vector<Sample> dense;
   SampleChunk chunk;
+  std::vector<uint32_t> slot_begin;  // per active vertex: its first slot in chunk.samples
+  std::vector<uint16_t> filled;      // per active vertex: slots written so far (rasters in order)
   // Where the chunk's vertices fall in the photo: the same for every photo of one camera (an RTI
   // capture: one projection per vertex instead of one per vertex and photo).
   std::vector<ImagePoint> projected;
@@ -279,10 +323,21 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
 
   for (size_t first = 0; first < mesh.vertex_count; first += chunk_vertices) {
     const size_t count = std::min(chunk_vertices, mesh.vertex_count - first);
-    // The block holds the vertices some photo sees only (a restricted mask, e.g. the diffuse-form
-    // pilot's 3 % of the mesh, or the far side of an object, costs nothing here).
+    // Only the vertices some photo sees get slots (a restricted mask, e.g. the diffuse-form
+    // pilot's 3 % of the mesh, or the far side of an object, costs nothing here), one slot per
+    // photo that the masks say sees the vertex, written in place: no dense vertices x photos block
+    // to zero, fill and copy out (at 1 M vertices x 24 photos it was 300 MB of fresh pages).
     const std::vector<uint32_t> active = seen_by_any(masks, first, count);
-    dense.resize(active.size() * rasters.size());
+    slot_begin.assign(active.size() + 1, 0);
+#pragma omp parallel for schedule(static)
+    for (long long a = 0; a < (long long)active.size(); ++a) {
+      uint32_t seen = 0;
+      for (size_t r = 0; r < rasters.size(); ++r) seen += masks.is_seen(r, first + active[size_t(a)]);
+      slot_begin[size_t(a) + 1] = seen;
+    }
+    for (size_t a = 0; a < active.size(); ++a) slot_begin[a + 1] += slot_begin[a];
+    chunk.samples.resize(slot_begin[active.size()]);  // the capacity stays for the next chunk
+    filled.assign(active.size(), 0);
     projected_for = nullptr;
     for (size_t r = 0; r < rasters.size(); ++r) {
       report(progress, (float(first) + float(count) * float(r) / float(raster_count)) / float(mesh.vertex_count),
@@ -290,7 +345,6 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
       const Raster &raster = rasters[r];
       if (!masks.sees_any(r, first, count)) {  // skip: do not even load the photo
         ++stats.rasters_skipped;
-        for (size_t a = 0; a < active.size(); ++a) dense[a * rasters.size() + r].flags = kOccluded;
         continue;
       }
       const auto photo = photos.get(raster.image_path, raster.width(), raster.height());
@@ -305,44 +359,30 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
 #pragma omp parallel for schedule(dynamic, 1024)
       for (long long a = 0; a < (long long)active.size(); ++a) {
         const size_t v = first + active[size_t(a)];
-        Sample &out = dense[size_t(a) * rasters.size() + r];
-        if (!masks.is_seen(r, v)) {
-          out.flags = kOccluded;  // not seen: never stored (why is counted by the visibility pass)
-          continue;
-        }
+        if (!masks.is_seen(r, v)) continue;  // not seen: no slot (why is counted by the visibility pass)
+        Sample &out = chunk.samples[slot_begin[size_t(a)] + filled[size_t(a)]++];
         make_sample(mesh.positions + 3 * v, mesh.normals + 3 * v, raster, uint16_t(r), light, *photo, true,
                     masks.is_lit(r, v), settings_of_vertex(v), out, masks.own_texels(r, v), &projected[size_t(a)]);
       }
     }
-    // Compact: keep samples seen by the camera, in vertex order.
+    std::vector<uint32_t> kept(active.size());
+    finish_vertex_samples(chunk.samples, slot_begin, kept, rasters, mesh, first, active, settings.resolution_weights,
+                          stats);
+    // Offsets over the chunk's vertices (no samples for those no photo sees); samples that the
+    // footprint put off the photo leave gaps, closed in vertex order (rare: photo borders).
     chunk.first_vertex = uint32_t(first);
     chunk.vertex_count = uint32_t(count);
     chunk.offsets.assign(count + 1, 0);
-    chunk.samples.clear();
-    size_t stored = 0;  // reserved at once: growing by doubling copied a 1 M chunk's samples twice
-    for (const Sample &s : dense) stored += !(s.flags & kNotSeen);
-    chunk.samples.reserve(stored);
-    std::vector<float> resolution(rasters.size(), 0.0f);
     for (size_t a = 0, i = 0; i < count; ++i) {
       chunk.offsets[i + 1] = chunk.offsets[i];
-      if (a == active.size() || active[a] != i) continue;  // seen by no photo: no samples
-      const float *p = mesh.positions + 3 * (first + i), *n = mesh.normals + 3 * (first + i);
-      float best = 0;
-      if (settings.resolution_weights)
-        for (size_t r = 0; r < rasters.size(); ++r)
-          if (!(dense[a * rasters.size() + r].flags & kNotSeen))
-            best = std::max(best, resolution[r] = photo_resolution(rasters[r], p, n));
-      for (size_t r = 0; r < rasters.size(); ++r) {
-        Sample &s = dense[a * rasters.size() + r];
-        if (s.flags & kNotSeen) continue;
-        for (uint16_t f = s.flags; f; f &= uint16_t(f - 1)) ++stats.flag_counts[bit_index(uint16_t(f & -f))];
-        s.resolution = best > 0 ? resolution_code(resolution[r] / best) : 0;
-        chunk.samples.push_back(s);
-        ++stats.raster_seen_vertices[r];
-      }
-      chunk.offsets[i + 1] = uint32_t(chunk.samples.size());
+      if (a == active.size() || active[a] != i) continue;
+      const uint32_t to = chunk.offsets[i];
+      if (to != slot_begin[a] && kept[a] > 0)
+        std::memmove(chunk.samples.data() + to, chunk.samples.data() + slot_begin[a], kept[a] * sizeof(Sample));
+      chunk.offsets[i + 1] = to + kept[a];
       ++a;
     }
+    chunk.samples.resize(chunk.offsets[count]);
     stats.stored += chunk.samples.size();
     ++stats.chunks;
     consume(chunk);

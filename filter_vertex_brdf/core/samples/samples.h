@@ -108,7 +108,8 @@ struct GatherSettings {
 
 // Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
 // not occluded (the camera pass combined with the per-vertex frustum/facing test), `lit` = not in
-// cast shadow. Per-photo counts say why vertices were not seen.
+// cast shadow, tested for the vertices the photo sees only (the others read as lit). Per-photo
+// counts say why vertices were not seen.
 struct VisibilityMasks {
   size_t vertex_count = 0;
   size_t raster_count = 0;

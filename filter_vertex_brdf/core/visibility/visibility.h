@@ -64,6 +64,9 @@ inline float own_surface_depth_slack(float vertex_depth, float focal_px, float t
   return tolerance + 1.5f * vertex_depth / focal_px * 5.0f;
 }
 
+// Whether light_pass's `only` asks for vertex v (every vertex without one).
+inline bool light_test_wanted(const uint64_t *only, size_t v) { return !only || ((only[v / 64] >> (v % 64)) & 1u); }
+
 class VisibilityBackend {
 public:
   virtual ~VisibilityBackend() = default;
@@ -82,7 +85,9 @@ public:
   // directional light shines from `light.direction` (an orthographic shadow map over the mesh; CPU:
   // rays along it); a point light from `light.position` (a perspective shadow map from there,
   // fitted to the mesh's bounding sphere; CPU: rays towards the position, stopping there).
-  virtual void light_pass(const LightSource &light, uint8_t *out) = 0;
+  // `only` (optional): bit v % 64 of only[v / 64] marks the vertices whose answer is wanted (the
+  // vertices a photo sees); the others are not tested and get 1. The shadow map is the same.
+  virtual void light_pass(const LightSource &light, uint8_t *out, const uint64_t *only = nullptr) = 0;
   // The depth maps of the passes (GL back end; zeros elsewhere): the last camera pass's map size and
   // divisor (pass_size.h), the last light pass's side, and their ranges over all passes so far.
   struct PassSizes {

@@ -107,7 +107,7 @@ public:
   CpuVisibility(const MeshView &mesh, const VisibilitySettings &settings);
   const char *name() const override { return "CPU ray casting"; }
   void camera_pass(const Shot &shot, uint8_t *out) override;
-  void light_pass(const LightSource &light, uint8_t *out) override;
+  void light_pass(const LightSource &light, uint8_t *out, const uint64_t *only) override;
 
 private:
   // True when a triangle lies on the ray from `from` along unit `dir` within (0, max_dist].
@@ -264,7 +264,7 @@ void CpuVisibility::camera_pass(const Shot &shot, uint8_t *out) {
   }
 }
 
-void CpuVisibility::light_pass(const LightSource &light, uint8_t *out) {
+void CpuVisibility::light_pass(const LightSource &light, uint8_t *out, const uint64_t *only) {
   const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
   if (light.positional) {  // segments towards the light, stopping there
     for (float c : light.position)
@@ -276,6 +276,10 @@ void CpuVisibility::light_pass(const LightSource &light, uint8_t *out) {
       marks.stamps.assign(triangles_.size(), 0u);
 #pragma omp for schedule(dynamic, 256)
       for (ptrdiff_t v = 0; v < n; ++v) {
+        if (!light_test_wanted(only, size_t(v))) {
+          out[v] = 1;
+          continue;
+        }
         const float *p = mesh_.positions + 3 * v;
         out[v] = blocked_towards(marks, vcg::Point3f(p[0], p[1], p[2]), light_pos) ? 0 : 1;
       }
@@ -294,6 +298,10 @@ void CpuVisibility::light_pass(const LightSource &light, uint8_t *out) {
     marks.stamps.assign(triangles_.size(), 0u);
 #pragma omp for schedule(dynamic, 256)
     for (ptrdiff_t v = 0; v < n; ++v) {
+      if (!light_test_wanted(only, size_t(v))) {
+        out[v] = 1;
+        continue;
+      }
       const float *p = mesh_.positions + 3 * v;
       const vcg::Point3f pos(p[0], p[1], p[2]);
       out[v] = blocked(marks, pos + dir * tolerance_, dir, max_dist) ? 0 : 1;

@@ -87,7 +87,7 @@ public:
     return test_program_ ? "OpenGL (depth tests in a compute shader)" : "OpenGL (depth maps read back, tested on the CPU)";
   }
   void camera_pass(const Shot &shot, uint8_t *out) override;
-  void light_pass(const LightSource &light, uint8_t *out) override;
+  void light_pass(const LightSource &light, uint8_t *out, const uint64_t *only) override;
   PassSizes last_pass_sizes() const override { return sizes_; }
 
 private:
@@ -105,6 +105,7 @@ private:
     float light_scale = 1;      // light pass
     bool perspective = false;   // light pass
     bool window_depth = false;  // the map holds window depth (RenderTargetKind::WindowDepth)
+    const uint64_t *only = nullptr;  // light pass: the vertices to test (light_pass's `only`)
   };
   void test_on_gpu(const GlRenderTarget &target, const TestPass &pass, uint8_t *out, const std::string &what);
   void fill(uint8_t *out, uint8_t value) const;
@@ -124,12 +125,13 @@ private:
   GLint d_view_ = -1, d_projection_ = -1;
   GlRenderTarget camera_target_, light_target_, light_window_target_;
   GLuint test_program_ = 0, codes_ = 0;  // compute-shader tests; 0 when they are off or unsupported
+  GLuint only_ = 0;                      // the light pass's `only` bits, for the tests
   struct TestUniforms {
     GLint vertex_count = -1, first_word = -1, light_pass = -1, view = -1, projection = -1, width = -1, height = -1;
     GLint tolerance = -1, slack_per_depth = -1, light_scale = -1, perspective = -1, depth = -1;
-    GLint divisor = -1, photo_width = -1, photo_height = -1, window_depth = -1, unproject = -1;
+    GLint divisor = -1, photo_width = -1, photo_height = -1, window_depth = -1, unproject = -1, only = -1;
   } tu_;
-  GLsizeiptr codes_bytes_ = 0;
+  GLsizeiptr codes_bytes_ = 0, only_bytes_ = 0;
   std::vector<float> depth_;     // read-back buffer, reused between passes
   EdgeSample edges_;             // sizes the passes (pass_size.h)
   int max_shadow_map_ = 0;       // resolved_shadow_map_size: the largest light pass
@@ -179,8 +181,9 @@ void GlVisibility::release_gl() {
   if (program_) gl_.DeleteProgram(program_);
   if (test_program_) gl_.DeleteProgram(test_program_);
   if (codes_) gl_.DeleteBuffers(1, &codes_);
-  vao_ = vbo_ = ibo_ = program_ = test_program_ = codes_ = 0;
-  codes_bytes_ = 0;
+  if (only_) gl_.DeleteBuffers(1, &only_);
+  vao_ = vbo_ = ibo_ = program_ = test_program_ = codes_ = only_ = 0;
+  codes_bytes_ = only_bytes_ = 0;
 }
 
 void GlVisibility::upload_mesh() {
@@ -252,11 +255,12 @@ void GlVisibility::build_test_program() {
   tu_.tolerance = at("u_tolerance"), tu_.slack_per_depth = at("u_slack_per_depth");
   tu_.light_scale = at("u_light_scale"), tu_.perspective = at("u_perspective"), tu_.depth = at("u_depth");
   tu_.divisor = at("u_divisor"), tu_.photo_width = at("u_photo_width"), tu_.photo_height = at("u_photo_height");
-  tu_.window_depth = at("u_window_depth"), tu_.unproject = at("u_unproject");
+  tu_.window_depth = at("u_window_depth"), tu_.unproject = at("u_unproject"), tu_.only = at("u_only");
   depth_only_program_ = build_program(gl_, kLinearDepthVertexShader, kDepthOnlyFragmentShader, "the depth-only light pass");
   d_view_ = gl_.GetUniformLocation(depth_only_program_, "u_view");
   d_projection_ = gl_.GetUniformLocation(depth_only_program_, "u_projection");
   gl_.GenBuffers(1, &codes_);
+  gl_.GenBuffers(1, &only_);
 }
 
 // Tests every vertex against the depth map of `t` in the compute shader and reads the codes back
@@ -297,6 +301,22 @@ void GlVisibility::test_on_gpu(const GlRenderTarget &t, const TestPass &pass, ui
   gl_.BindTexture(GL_TEXTURE_2D, t.color);
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, vbo_);  // the origin-relative positions
   gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, codes_);
+  // The wanted-vertex bits: the 64-bit words are read as pairs of 32-bit ones (little-endian).
+  const bool use_only = pass.light && pass.only;
+  if (use_only) {
+    const GLsizeiptr only_bytes = GLsizeiptr(((n + 63) / 64) * 8);
+    gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, only_);
+    if (only_bytes > only_bytes_) {
+      gl_.BufferData(GL_SHADER_STORAGE_BUFFER, only_bytes, nullptr, GL_DYNAMIC_DRAW);
+      only_bytes_ = only_bytes;
+    }
+    gl_.BufferSubData(GL_SHADER_STORAGE_BUFFER, 0, only_bytes, pass.only);
+    gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, only_);
+    gl_.BindBuffer(GL_SHADER_STORAGE_BUFFER, codes_);
+  } else {
+    gl_.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, codes_);  // a valid buffer there; not read
+  }
+  gl_.Uniform1i(tu_.only, use_only ? 1 : 0);
   const size_t max_words = size_t(65535) * kTestLocalSize;  // guaranteed work-group count limit
   for (size_t first = 0; first < words; first += max_words) {
     const size_t count = std::min(max_words, words - first);
@@ -402,7 +422,7 @@ void GlVisibility::camera_pass(const Shot &shot, uint8_t *out) {
 
 // The shadow map from the light (light_view.h: orthographic for a directional light, a perspective
 // frustum fitted to the bounding sphere for a point light), then every vertex against it.
-void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
+void GlVisibility::light_pass(const LightSource &light, uint8_t *out, const uint64_t *only) {
   if (mesh_.vertex_count == 0) return;
   LightView lv;
   try {
@@ -432,6 +452,7 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
       pass.projection = projection;
       pass.light_scale = lv.scale;
       pass.window_depth = true;
+      pass.only = only;
       test_on_gpu(light_window_target_, pass, out, "the shadow tests");
       return;
     }
@@ -444,6 +465,7 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
       pass.view = view;
       pass.light_scale = lv.scale;
       pass.perspective = lv.perspective;
+      pass.only = only;
       test_on_gpu(light_target_, pass, out, "the shadow tests");
       return;
     }
@@ -454,6 +476,10 @@ void GlVisibility::light_pass(const LightSource &light, uint8_t *out) {
   const ptrdiff_t n = ptrdiff_t(mesh_.vertex_count);
 #pragma omp parallel for schedule(static)
   for (ptrdiff_t v = 0; v < n; ++v) {
+    if (!light_test_wanted(only, size_t(v))) {
+      out[v] = 1;
+      continue;
+    }
     const float *p = mesh_.positions + 3 * v;
     const float local[3] = {p[0] - origin_[0], p[1] - origin_[1], p[2] - origin_[2]};
     float wx, wy, depth;
