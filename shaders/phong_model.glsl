@@ -6,7 +6,7 @@
 //
 // Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
 //   f = rho d + k_s max(s, 0)^alpha,  rho = k_d C,  unit irradiance
-//   d: the diffuse factor, N.L (Lambert) or N.L T(N.L) T(max(N.E, 0.2)) / T(1)^2 (coated), per
+//   d: the diffuse factor, N.L (Lambert) or N.L T(max(N.L, 0.2)) T(max(N.E, 0.2)) / T(1)^2 (coated), per
 //      vertex (`coated` 1 or 0, DiffuseForms; blended linearly across a triangle that has both);
 //   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
 //   N.L <= 0: attached shadow, black (the callers test it before calling phong_terms).
@@ -23,7 +23,7 @@
 
 uniform int u_half_angle_lobe;        // 0: R.E, 1: N.H
 uniform float u_coat_index;           // kCoatIndex
-uniform float u_coat_min_n_dot_e;     // kCoatMinNdotE
+uniform float u_coat_min_cosine;     // kCoatMinCosine
 
 // samples/diffuse_form.h coat_transmission.
 float coat_transmission(float c) {
@@ -39,7 +39,7 @@ float coat_transmission(float c) {
 float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
   if (!(coated > 0.0) || !(n_dot_l > 0.0)) return n_dot_l;
   float t1 = coat_transmission(1.0);
-  float coat = n_dot_l * coat_transmission(n_dot_l) * coat_transmission(max(n_dot_e, u_coat_min_n_dot_e)) / (t1 * t1);
+  float coat = n_dot_l * coat_transmission(max(n_dot_l, u_coat_min_cosine)) * coat_transmission(max(n_dot_e, u_coat_min_cosine)) / (t1 * t1);
   return mix(n_dot_l, coat, min(coated, 1.0));
 }
 
