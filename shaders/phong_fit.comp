@@ -47,6 +47,7 @@ uniform float u_kd_max, u_ks_max, u_specular_threshold;
 uniform int u_max_iterations, u_min_specular, u_min_lobe;
 uniform float u_lobe_threshold;  // both thresholds already on the lobe's cosine (lobe_threshold())
 uniform int u_half_angle_lobe;   // 1: s is N.H (SQ's sampling term is then 2 s^2 - 1, lobe_as_r_dot_e)
+uniform int u_ggx_lobe;          // 1: the lobe is GGX's D(N.H)/D(1), not s^alpha (samples/lobe.h lobe_value)
 
 const uint kUnusable = 0x13Fu;  // kNotSeen | kShadowed | kSaturated | kMixedPixel (samples.h)
 const uint kStatusDiffuseOnly = 1u, kStatusFull = 2u;
@@ -86,9 +87,22 @@ float ln_s(float s) {
          (1.0 + u2 * (1.0 / 3.0 + u2 * (1.0 / 5.0 + u2 * (1.0 / 7.0 + u2 * (1.0 / 9.0 + u2 * (1.0 / 11.0 + u2 / 13.0))))));
 }
 
-// s^alpha without ln(0), overflow or denormals (as the reference's lobe()).
+// GGX's D(N.H)/D(1) with a^2 = 2 / (alpha + 2) (samples/lobe.h lobe_value), for s in (0, 1].
+float ggx_lobe(float s, float alpha) {
+  const float a2 = 2.0 / (alpha + 2.0), r = a2 / (a2 + (1.0 - s * s) * (1.0 - a2));
+  return r * r;
+}
+
+// Its derivative in t = ln(alpha) (lobe.h lobe_dvalue_dlog_alpha), for s in (0, 1).
+float ggx_lobe_dt(float s, float alpha) {
+  const float a2 = 2.0 / (alpha + 2.0), u = 1.0 - s * s, den = a2 + u * (1.0 - a2), r = a2 / den;
+  return 2.0 * r * u / (den * den) * (-2.0 * alpha / ((alpha + 2.0) * (alpha + 2.0)));
+}
+
+// The lobe g(s, alpha) without ln(0), overflow or denormals (as the reference's lobe()).
 float lobe(float s, float alpha) {
   if (!(s > 0.0)) return 0.0;
+  if (u_ggx_lobe != 0) return ggx_lobe(min(s, 1.0), alpha);
   return exp(max(alpha * ln_s(min(s, 1.0)), -80.0));
 }
 
@@ -227,12 +241,13 @@ void objective(inout Linear L, float alpha) {
     if (!load(i, x)) continue;
     // k_s = 0 (every diffuse-only fit): no lobe, and no alpha derivative.
     const bool lobed = L.ks > 0.0 && x.s > 0.0;
-    const float lx = lobed ? ln_s(min(x.s, 1.0)) : 0.0;
-    const float g = lobed ? exp(max(alpha * lx, -80.0)) : 0.0;
+    const bool ggx = u_ggx_lobe != 0;
+    const float lx = lobed && !ggx ? ln_s(min(x.s, 1.0)) : 0.0;
+    const float g = lobed ? (ggx ? ggx_lobe(min(x.s, 1.0), alpha) : exp(max(alpha * lx, -80.0))) : 0.0;
     const vec3 r = x.p - L.rho * x.d - vec3(L.ks * g);
     kahan_add(e, comp, x.w * dot(r, r));
     if (lobed && x.s < 1.0) {  // ln s finite and non-zero
-      const float dg = L.ks * g * lx * alpha;  // d(k_s s^alpha)/dt
+      const float dg = L.ks * (ggx ? ggx_lobe_dt(x.s, alpha) : g * lx * alpha);  // d(k_s g)/dt
       grad += -2.0 * x.w * (r.r + r.g + r.b) * dg;
       curv += 6.0 * x.w * dg * dg;
     }

@@ -5,7 +5,8 @@
 // no #version here.
 //
 // Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
-//   f = rho d + k_s max(s, 0)^alpha,  rho = k_d C,  unit irradiance
+//   f = rho d + k_s g(s, alpha),  rho = k_d C,  unit irradiance; g = max(s, 0)^alpha, or GGX's
+//      D(N.H)/D(1) with a^2 = 2 / (alpha + 2) when u_ggx_lobe != 0 (samples/lobe.h lobe_value)
 //   d: the diffuse factor, N.L (Lambert) or N.L T(max(N.L, 0.2)) T(max(N.E, 0.2)) / T(1)^2 (coated), per
 //      vertex (`coated` 1 or 0, DiffuseForms; blended linearly across a triangle that has both);
 //   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
@@ -22,6 +23,7 @@
 //     live view multiplies by the exposure, clips at 1 and encodes sRGB for the screen.
 
 uniform int u_half_angle_lobe;        // 0: R.E, 1: N.H
+uniform int u_ggx_lobe;               // 1: GGX lobe on N.H (LobeForm::GgxNH)
 uniform float u_coat_index;           // kCoatIndex
 uniform float u_coat_min_cosine;     // kCoatMinCosine
 
@@ -50,10 +52,17 @@ float lobe_cosine(vec3 n, vec3 l, vec3 e) {
   return dot(2.0 * dot(n, l) * n - l, e);
 }
 
-// k_s s^alpha for s > 0 (the exponent's logarithm floored at -80: no denormals, no NaN).
+// k_s g(s, alpha) for s > 0: s^alpha with the exponent's logarithm floored at -80 (no denormals,
+// no NaN), or the GGX lobe (a positive denominator for alpha >= 0).
 float phong_specular(float ks, float alpha, float s) {
   if (!(ks > 0.0) || !(s > 0.0)) return 0.0;
-  return ks * exp(max(alpha * log(min(s, 1.0)), -80.0));
+  float c = min(s, 1.0);
+  if (u_ggx_lobe != 0) {
+    float a2 = 2.0 / (max(alpha, 0.0) + 2.0);
+    float r = a2 / (a2 + (1.0 - c * c) * (1.0 - a2));
+    return ks * r * r;
+  }
+  return ks * exp(max(alpha * log(c), -80.0));
 }
 
 // The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value.

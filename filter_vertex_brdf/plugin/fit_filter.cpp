@@ -92,13 +92,15 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                             "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
                             "the highlight samples and keeps the better one). Range [1, 2000]."));
   params.addParam(RichEnum(kSpecularLobe, int(vbrdf::kFitLobe),
-                           QStringList() << "Phong on R.E (thesis)" << "Blinn-Phong on N.H",
+                           QStringList() << "Phong on R.E (thesis)" << "Blinn-Phong on N.H" << "GGX on N.H",
                            "Specular lobe",
-                           "What the shininess is the exponent of: the cosine between the mirrored light and "
-                           "the view (R.E, the thesis's Phong) or between the normal and the half vector "
-                           "(N.H, Blinn-Phong; follows glossy highlights seen away from the camera axis "
-                           "better). Written with the result (per-vertex lobe_form) and used by every "
-                           "later step (relighting, evaluation)."));
+                           "The highlight's shape. Phong on R.E (the thesis): the cosine between the mirrored "
+                           "light and the view to the power shininess. Blinn-Phong on N.H: the cosine between "
+                           "the normal and the half vector to that power (follows glossy highlights seen away "
+                           "from the camera axis better). GGX on N.H: the microfacet lobe of real glossy "
+                           "surfaces, with its long tails; shininess is its Phong-equivalent exponent, "
+                           "roughness sqrt(2 / (shininess + 2)). Written with the result (per-vertex "
+                           "lobe_form) and used by every later step (relighting, evaluation)."));
   params.addParam(RichEnum(kDiffuseTerm, int(vbrdf::kFitDiffuseChoice),
                            QStringList() << "Auto" << "Lambert (thesis)" << "Coated (Fresnel in and out)",
                            "Diffuse term",
@@ -148,7 +150,8 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   const int fill_rings = params.getInt(kFillUnseenRings);
   require(fill_rings >= 0 && fill_rings <= 1000, kFillUnseenRings, "must be in [0, 1000]");
   const int lobe = params.getEnum(kSpecularLobe);
-  require(lobe >= 0 && lobe <= 1, kSpecularLobe, "must be 0 (Phong on R.E) or 1 (Blinn-Phong on N.H)");
+  require(lobe >= 0 && lobe < vbrdf::kLobeFormCount, kSpecularLobe,
+          "must be 0 (Phong on R.E), 1 (Blinn-Phong on N.H) or 2 (GGX on N.H)");
   const int diffuse = params.getEnum(kDiffuseTerm);
   require(diffuse >= 0 && diffuse <= 2, kDiffuseTerm, "must be 0 (Auto), 1 (Lambert) or 2 (Coated)");
 

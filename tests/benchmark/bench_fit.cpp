@@ -181,7 +181,7 @@ void score(const SampleChunk &chunk, const std::vector<Truth> &truth, const std:
       const Sample &s = chunk.samples[i];
       if (!usable(s)) continue;
       float fit[3], tru[3];
-      evaluate_phong(f, std::min(s.d, 1.0f), s.lobe_cos, fit);
+      evaluate_phong(f, std::min(s.d, 1.0f), s.lobe_cos, LobeForm::PhongRE, fit);
       true_model(t, std::min(s.d, 1.0f), s.lobe_cos, tru);
       for (int c = 0; c < 3; ++c) model_e += s.d * double(fit[c] - tru[c]) * double(fit[c] - tru[c]);
       model_w += 3 * s.d;

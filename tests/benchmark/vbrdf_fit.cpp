@@ -4,7 +4,7 @@
 //             [--fit auto|gpu|cpu|off] [--iterations 20] [--alpha0 10] [--min-specular 2]
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
 //             [--photo-shadows on|off]
-//             [--lobe re|nh] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
+//             [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -33,7 +33,7 @@ int usage() {
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
                "                 [--photo-shadows on|off]\n"
-               "                 [--lobe re|nh] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n";
+               "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n";
   return 2;
 }
 } // namespace

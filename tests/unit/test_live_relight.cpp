@@ -168,6 +168,9 @@ TEST(LiveRelight, MatchesRelightRendererPhongLambert) {
 TEST(LiveRelight, MatchesRelightRendererBlinnCoated) {
   check_forms(LobeForm::BlinnNH, DiffuseForms::everywhere(DiffuseForm::Coated));
 }
+TEST(LiveRelight, MatchesRelightRendererGgxCoated) {
+  check_forms(LobeForm::GgxNH, DiffuseForms::everywhere(DiffuseForm::Coated));
+}
 // A coat map: every other vertex coated (both renderers blend the forms across triangles alike).
 TEST(LiveRelight, MatchesRelightRendererWithACoatMap) {
   const size_t n = make_scene().mesh.positions.size() / 3;

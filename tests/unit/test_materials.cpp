@@ -24,7 +24,8 @@ struct Scene {
 
 // A (grid + 1) x (grid + 1) grid whose normals fan out over +-40 degrees (a cap), 16 lights, camera along +z.
 // Vertices with x < 0 are glossy when `two_materials`, else every vertex is glossy.
-// The true lobe is ks * cos^alpha with the cosine of `form` (R.E or N.H), as is Sample::lobe_cos.
+// The true lobe is ks * g(cos, alpha) of `form` (cos^alpha on R.E or N.H, or GGX on N.H;
+// lobe_value), the cosine as Sample::lobe_cos.
 Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed, LobeForm form = LobeForm::PhongRE, int grid = 30) {
   Scene sc;
   sc.mesh = test::make_grid(grid, 1.0f, 0.0f);
@@ -56,7 +57,7 @@ Scene make_scene(bool two_materials, float ks, float alpha, unsigned seed, LobeF
       const float re = lobe_cosine(LobeForm::PhongRE, N, L, E), s = lobe_cosine(form, N, L, E);
       Sample smp{};
       smp.d = d, smp.lobe_cos = s, smp.raster = uint16_t(l);
-      const float g = glossy && s > 0 && d > 0 ? ks * std::pow(s, alpha) : 0.0f;
+      const float g = glossy && s > 0 && d > 0 ? ks * float(lobe_value(form, s, alpha)) : 0.0f;
       for (int c = 0; c < 3; ++c) smp.rgb[c] = std::max(0.0f, (rho[c] * std::max(d, 0.0f) + g) * (1 + 0.01f * gauss(rng)));
       smp.flags = uint16_t((d <= 0 ? kAttachedShadow : 0) | (d > 0 && d < 0.2f ? kGrazing : 0) | (re > 0.9f ? kHighlight : 0));
       sc.chunk.samples.push_back(smp);
@@ -113,7 +114,7 @@ class MaterialsBothLobes : public ::testing::TestWithParam<LobeForm> {};
 // blend between the material's lobe and its own data) recovered, in either lobe form.
 TEST_P(MaterialsBothLobes, TwoMaterialsAndTheirLobesAreRecovered) {
   const LobeForm form = GetParam();
-  const float ks = 0.5f, alpha = form == LobeForm::BlinnNH ? 120.0f : 30.0f;
+  const float ks = 0.5f, alpha = form != LobeForm::PhongRE ? 120.0f : 30.0f;
   const Scene sc = make_scene(true, ks, alpha, 7, form);
   MaterialOptions everywhere;
   everywhere.keep_full_fits = false;  // every glossy vertex takes the material-regularised lobe
@@ -168,9 +169,10 @@ TEST(Materials, ChosenOnASubsampleOfALargeMesh) {
   expect_two_materials_found(sc, r, ks, alpha);
 }
 
-INSTANTIATE_TEST_SUITE_P(LobeForms, MaterialsBothLobes, ::testing::Values(LobeForm::PhongRE, LobeForm::BlinnNH),
+INSTANTIATE_TEST_SUITE_P(LobeForms, MaterialsBothLobes,
+                         ::testing::Values(LobeForm::PhongRE, LobeForm::BlinnNH, LobeForm::GgxNH),
                          [](const ::testing::TestParamInfo<LobeForm> &i) {
-                           return std::string(i.param == LobeForm::BlinnNH ? "NH" : "RE");
+                           return std::string(i.param == LobeForm::GgxNH ? "GGX" : i.param == LobeForm::BlinnNH ? "NH" : "RE");
                          });
 
 TEST(Materials, OneGlossyMaterialIsOneMaterial) {

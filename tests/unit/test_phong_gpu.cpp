@@ -328,9 +328,11 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
   }
   PhongFitOptions half_angle;
   half_angle.lobe = LobeForm::BlinnNH;
+  PhongFitOptions ggx;
+  ggx.lobe = LobeForm::GgxNH;
   PhongFitOptions mirror;  // R.E with resolution weights only
-  for (const PhongFitOptions *o : {&half_angle, &mirror}) {
-    const Agreement a = agree(chunk, *o, o->lobe == LobeForm::BlinnNH ? "N.H lobe, resolution weights" : "R.E lobe, resolution weights");
+  for (const PhongFitOptions *o : {&half_angle, &ggx, &mirror}) {
+    const Agreement a = agree(chunk, *o, (std::string(lobe_form_label(o->lobe)) + " lobe, resolution weights").c_str());
     EXPECT_GT(a.well, 1000);
     EXPECT_LE(a.well_disagree, a.well / 200);
   }

@@ -109,7 +109,9 @@ PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
       float expected[3];
       if (coat_map && p[0] > -0.55f && p[0] < 0.05f) continue;
       const DiffuseForm form = coat_map ? (p[0] < 0 ? DiffuseForm::Coated : DiffuseForm::Lambert) : settings.diffuse.uniform;
-      evaluate_phong(fits[0], diffuse_factor(form, d, n * e), refl * e, expected);
+      const float nf[3] = {n[0], n[1], n[2]}, lf[3] = {lv[0], lv[1], lv[2]}, ef[3] = {e[0], e[1], e[2]};
+      const float cosine = settings.lobe == LobeForm::PhongRE ? refl * e : lobe_cosine(settings.lobe, nf, lf, ef);
+      evaluate_phong(fits[0], diffuse_factor(form, d, n * e), cosine, settings.lobe, expected);
       const float irradiance = light_irradiance_at(light, pf);
       for (int k = 0; k < 3; ++k)
         c.worst = std::max(c.worst, double(std::fabs(pixel(r, x, y)[k] - expected[k] * irradiance)));
@@ -145,6 +147,23 @@ TEST(RelightRender, CoatedDiffuseMatchesTheModelEverywhere) {
   const PlaneCheck map = render_plane(*ctx, low, RelightRenderSettings(), true);  // per vertex
   EXPECT_GT(map.checked, 300u);
   EXPECT_LT(map.worst, 2e-3);
+}
+
+// The GGX lobe (lobe.h lobe_value): the shader's copy agrees with the CPU's over the plane, whose
+// pixels span the highlight and its tail; it is in effect (Blinn-Phong of the same exponent renders
+// other values).
+TEST(RelightRender, GgxLobeMatchesTheModelEverywhere) {
+  REQUIRE_GL(ctx);
+  const LightSource light = LightSource::directional({{0.3f, 1.0f, 0.4f}});
+  RelightRenderSettings ggx;
+  ggx.lobe = LobeForm::GgxNH;
+  const PlaneCheck c = render_plane(*ctx, light, ggx);
+  EXPECT_GT(c.checked, 500u);
+  EXPECT_LT(c.worst, 2e-3);
+  RelightRenderSettings blinn;
+  blinn.lobe = LobeForm::BlinnNH;
+  EXPECT_LT(render_plane(*ctx, light, blinn).worst, 2e-3);
+  EXPECT_GT(std::fabs(c.brightest - render_plane(*ctx, light, blinn).brightest) + std::fabs(c.darkest - render_plane(*ctx, light, blinn).darkest), 1e-3);
 }
 
 // A point light close over the plane: per pixel its own direction and the inverse-square fall-off.

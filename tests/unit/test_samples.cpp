@@ -347,8 +347,10 @@ TEST(Samples, HalfAngleLobeCosine) {
   EXPECT_EQ(lobe_cosine(LobeForm::BlinnNH, kFacing, opposite, kFacing), 0.0f);  // H undefined
   LobeForm parsed;
   EXPECT_TRUE(parse_lobe_form("nh", parsed) && parsed == LobeForm::BlinnNH);
+  EXPECT_TRUE(parse_lobe_form("ggx", parsed) && parsed == LobeForm::GgxNH);
+  EXPECT_TRUE(parse_lobe_form(lobe_form_name(LobeForm::GgxNH), parsed) && parsed == LobeForm::GgxNH);
   EXPECT_TRUE(parse_lobe_form(lobe_form_name(LobeForm::PhongRE), parsed) && parsed == LobeForm::PhongRE);
-  EXPECT_FALSE(parse_lobe_form("ggx", parsed));
+  EXPECT_FALSE(parse_lobe_form("cook_torrance", parsed));
 }
 
 TEST(Samples, ResolutionWeightFollowsDistanceAndObliquity) {
@@ -432,4 +434,37 @@ TEST(Samples, SampleWordMatchesTheShader) {
   uint32_t word = 0;
   std::memcpy(&word, reinterpret_cast<const char *>(&s) + 20, 4);
   EXPECT_EQ(word, 0x1234u | uint32_t(kHighlight | kMixedPixel | kRimFootprint) << 16 | 0x2Au << 26);
+}
+
+// The GGX lobe (lobe.h lobe_value): 1 at the peak, falling with the angle, the GGX distribution
+// D(N.H)/D(1) of roughness a with a^2 = 2 / (alpha + 2), heavier-tailed than (N.H)^alpha of the same
+// exponent; its derivative in ln alpha is the fits' Newton step, checked by finite differences.
+TEST(Lobe, GgxValueAndDerivative) {
+  for (double alpha : {1.0, 20.0, 300.0, 2000.0}) {
+    EXPECT_DOUBLE_EQ(lobe_value(LobeForm::GgxNH, 1.0, alpha), 1.0);
+    EXPECT_DOUBLE_EQ(lobe_value(LobeForm::GgxNH, 1.5, alpha), 1.0);  // clamped at 1
+    EXPECT_EQ(lobe_value(LobeForm::GgxNH, 0.0, alpha), 0.0);
+    EXPECT_EQ(lobe_value(LobeForm::GgxNH, -0.3, alpha), 0.0);
+    double previous = 1.0;
+    for (double s = 0.999; s > 0.05; s -= 0.05) {
+      const double g = lobe_value(LobeForm::GgxNH, s, alpha);
+      EXPECT_LT(g, previous) << s;
+      EXPECT_GT(g, 0.0) << s;
+      previous = g;
+      const double h = 1e-6, t = std::log(alpha);
+      const double fd = (lobe_value(LobeForm::GgxNH, s, std::exp(t + h)) - lobe_value(LobeForm::GgxNH, s, std::exp(t - h))) / (2 * h);
+      EXPECT_NEAR(lobe_dvalue_dlog_alpha(LobeForm::GgxNH, s, alpha), fd, 1e-6 + 1e-5 * std::fabs(fd)) << s << " " << alpha;
+      const double fd_pow = (lobe_value(LobeForm::BlinnNH, s, std::exp(t + h)) - lobe_value(LobeForm::BlinnNH, s, std::exp(t - h))) / (2 * h);
+      EXPECT_NEAR(lobe_dvalue_dlog_alpha(LobeForm::BlinnNH, s, alpha), fd_pow, 1e-6 + 1e-5 * std::fabs(fd_pow));
+    }
+  }
+  // GGX D by its textbook formula: a^2 / (pi ((a^2 - 1) c^2 + 1)^2), over D(1) = 1 / (pi a^2).
+  const double alpha = 86.9, a2 = 2 / (alpha + 2), c = 0.97;
+  const double d = a2 / ((a2 - 1) * c * c + 1) / ((a2 - 1) * c * c + 1);
+  EXPECT_NEAR(lobe_value(LobeForm::GgxNH, c, alpha), d * a2, 1e-12);
+  // The tail: 45 degrees off the peak, GGX keeps far more than the power law of the same exponent
+  // (which is the broader of the two near the peak: its curvature there is half GGX's).
+  const double s45 = std::cos(45 * 3.14159265358979 / 180), s5 = std::cos(5 * 3.14159265358979 / 180);
+  EXPECT_GT(lobe_value(LobeForm::GgxNH, s45, alpha), 1e6 * lobe_value(LobeForm::BlinnNH, s45, alpha));
+  EXPECT_LT(lobe_value(LobeForm::GgxNH, s5, alpha), lobe_value(LobeForm::BlinnNH, s5, alpha));
 }

@@ -3,7 +3,8 @@
 // precision, OpenMP) and the GPU back end (shaders/phong_fit.comp, float32).
 //
 // Model, per colour channel c, light of unit irradiance and white colour (after calibration):
-//     f_c = k_d d C_c + k_s max(s, 0)^alpha,  s = R.E or N.H (options.lobe, samples/lobe.h),
+//     f_c = k_d d C_c + k_s g(s, alpha),  s = R.E or N.H, g = s^alpha or the GGX lobe (options.lobe,
+//     samples/lobe.h lobe_value),
 //     d = N.L, or N.L with the coat's Fresnel transmission (Sample::d: the gatherer's diffuse form,
 //     samples/diffuse_form.h; the fit never evaluates the form itself)
 // Objective: sum over usable samples i of w_i * sum_c (P_ic - f_c)^2 + prior, with
@@ -24,7 +25,8 @@
 // One iteration = one alpha step + exact linear re-solve. Stops when the relative improvement
 // is below `tolerance`, after `max_iterations`, or when no damped step improves.
 //
-// Safeguards: s^alpha = exp(alpha * ln s) with s <= 0 giving 0 and alpha*ln s clamped at -80
+// Safeguards: s^alpha = exp(alpha * ln s) with s <= 0 giving 0 and alpha*ln s clamped at -80 (the
+// GGX form: a rational function of s and alpha with a positive denominator, lobe.h)
 // (no ln 0, no overflow, no denormals); alpha is kept in [alpha_min, alpha_max]; k_d in
 // [0, kd_max], k_s in [0, ks_max]; a singular k_s equation (no specular discrimination: all g_i
 // ~ 0 or g proportional to d) gives k_s = 0; fewer than `min_specular_samples` highlight samples
@@ -115,8 +117,9 @@ void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOp
                            VertexFit &fit);
 
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
-// d: the diffuse factor (Sample::d: N.L for Lambert, diffuse_factor() in general).
-void evaluate_phong(const VertexFit &fit, float d, float lobe_cos, float out_rgb[3]);
+// d: the diffuse factor (Sample::d: N.L for Lambert, diffuse_factor() in general); lobe_cos and
+// form: the lobe's cosine (Sample::lobe_cos) and the form the fit used (PhongFitOptions::lobe).
+void evaluate_phong(const VertexFit &fit, float d, float lobe_cos, LobeForm form, float out_rgb[3]);
 
 // True when the vertex has a reflectance model (any status but kFitNone).
 inline bool has_model(const VertexFit &fit) { return fit.status != kFitNone; }

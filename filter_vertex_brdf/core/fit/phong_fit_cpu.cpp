@@ -15,14 +15,12 @@ struct FitSample {
   double ln_s = 0;  // ln(min(s, 1)) where s > 0 (with_ln_s): the lobe's iterations need no log
 };
 
-// s^alpha without ln(0), overflow or denormals.
-inline double lobe(double s, double alpha) {
-  if (!(s > 0)) return 0;
-  return std::exp(std::max(alpha * std::log(std::min(s, 1.0)), -80.0));
-}
+// The lobe g(s, alpha) of the form (samples/lobe.h lobe_value).
+inline double lobe(LobeForm form, double s, double alpha) { return lobe_value(form, s, alpha); }
 
-// The same for a fit sample, from its stored logarithm (bit for bit the value of lobe()).
-inline double lobe(const FitSample &x, double alpha) {
+// The same for a fit sample; power forms from its stored logarithm (bit for bit lobe_value's).
+inline double lobe(LobeForm form, const FitSample &x, double alpha) {
+  if (!lobe_is_power(form)) return lobe_value(form, x.s, alpha);
   return x.s > 0 ? std::exp(std::max(alpha * x.ln_s, -80.0)) : 0.0;
 }
 
@@ -39,8 +37,8 @@ struct Linear {
 
 class VertexProblem {
 public:
-  VertexProblem(const std::vector<FitSample> &samples, const double rho0[3], double prior)
-      : samples_(samples), prior_(prior) {
+  VertexProblem(const std::vector<FitSample> &samples, const double rho0[3], double prior, LobeForm form)
+      : samples_(samples), prior_(prior), form_(form) {
     for (int c = 0; c < 3; ++c) rho0_[c] = rho0[c];
     for (const FitSample &x : samples_) {
       a_ += x.w * x.d * x.d;
@@ -57,7 +55,7 @@ public:
     if (ks_free)
       for (size_t i = 0; i < samples_.size(); ++i) {
         const FitSample &x = samples_[i];
-        const double g = lobes_[i] = lobe(x, alpha);
+        const double g = lobes_[i] = lobe(form_, x, alpha);
         b += x.w * x.d * g;
         g2 += x.w * g * g;
         for (int c = 0; c < 3; ++c) q[c] += x.w * g * x.p[c];
@@ -109,8 +107,9 @@ public:
     grad = curv = 0;
     for (const FitSample &x : samples_) {
       if (!(x.s > 0) || x.s >= 1) continue;
-      const double g = lobe(x, alpha);
-      const double dg = L.ks * g * x.ln_s * alpha;  // d(k_s s^alpha)/dt
+      const double g = lobe(form_, x, alpha);
+      const double dg = L.ks * (lobe_is_power(form_) ? g * x.ln_s * alpha  // d(k_s g)/dt
+                                                     : lobe_dvalue_dlog_alpha(form_, x.s, alpha));
       for (int c = 0; c < 3; ++c) {
         const double r = x.p[c] - L.rho[c] * x.d - L.ks * g;
         grad += -2 * x.w * r * dg;
@@ -123,8 +122,9 @@ private:
   const std::vector<FitSample> &samples_;
   double rho0_[3];
   double prior_;
+  LobeForm form_;
   double a_ = 0, p_[3] = {0, 0, 0};
-  mutable std::vector<double> lobes_;  // s^alpha of the last solve's alpha
+  mutable std::vector<double> lobes_;  // g(s, alpha) of the last solve's alpha
 };
 
 // Thesis 4.5-style initial shininess: ln(P - rho0 d) = ln k_s + alpha ln s over highlight samples.
@@ -164,7 +164,7 @@ void quality_metrics(const std::vector<FitSample> &samples, const VertexFit &fit
   int nd = 0, ns = 0;
   for (const FitSample &x : samples) {
     float f[3];
-    evaluate_phong(fit, float(x.d), float(x.s), f);
+    evaluate_phong(fit, float(x.d), float(x.s), form, f);
     double err2 = 0;
     for (int c = 0; c < 3; ++c) err2 += (x.p[c] - f[c]) * (x.p[c] - f[c]);
     e += x.w * err2, w += x.w;
@@ -194,9 +194,9 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 
 } // namespace
 
-void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, float out[3]) {
+void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out[3]) {
   const float d = std::max(d_in, 0.0f);
-  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe(lobe_cos, fit.shininess)) : 0.0f;
+  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe(form, lobe_cos, fit.shininess)) : 0.0f;
   for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
 }
 
@@ -270,7 +270,7 @@ void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool w
 
   double rho0[3];
   diffuse_only_estimate(samples, rho0);
-  const VertexProblem problem(samples, rho0, o.diffuse_prior * total_w);
+  const VertexProblem problem(samples, rho0, o.diffuse_prior * total_w, o.lobe);
 
   double alpha = std::min(std::max(double(o.alpha_init), double(o.alpha_min)), double(o.alpha_max));
   Linear best = problem.solve(alpha, ks_free, o);

@@ -45,7 +45,7 @@ std::string phong_fit_source() { return shaders::phong_fit_comp; }
 struct Uniforms {
   GLint vertex_count = -1, sample_base = -1, alpha_init = -1, alpha_min = -1, alpha_max = -1;
   GLint tolerance = -1, weight_cap = -1, prior = -1, kd_max = -1, ks_max = -1, threshold = -1;
-  GLint max_iterations = -1, min_specular = -1, min_lobe = -1, lobe_threshold = -1, half_angle = -1;
+  GLint max_iterations = -1, min_specular = -1, min_lobe = -1, lobe_threshold = -1, half_angle = -1, ggx = -1;
 };
 
 // One set of buffers for a dispatch batch.
@@ -147,7 +147,8 @@ PhongFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_p
                  {&u.kd_max, "u_kd_max"},             {&u.ks_max, "u_ks_max"},
                  {&u.threshold, "u_specular_threshold"}, {&u.max_iterations, "u_max_iterations"},
                  {&u.min_specular, "u_min_specular"}, {&u.min_lobe, "u_min_lobe"},
-                 {&u.lobe_threshold, "u_lobe_threshold"}, {&u.half_angle, "u_half_angle_lobe"}};
+                 {&u.lobe_threshold, "u_lobe_threshold"}, {&u.half_angle, "u_half_angle_lobe"},
+                 {&u.ggx, "u_ggx_lobe"}};
     for (const auto &n : names) {
       *n.location = gl.GetUniformLocation(program, n.name);
       if (*n.location < 0)
@@ -198,7 +199,8 @@ void PhongFitGpu::Impl::set_options(const PhongFitOptions &o) const {
   gl.Uniform1i(u.min_specular, o.min_specular_samples);
   gl.Uniform1i(u.min_lobe, o.min_lobe_samples);
   gl.Uniform1f(u.lobe_threshold, lobe_threshold(o.lobe, o.lobe_threshold));
-  gl.Uniform1i(u.half_angle, o.lobe == LobeForm::BlinnNH ? 1 : 0);
+  gl.Uniform1i(u.half_angle, o.lobe != LobeForm::PhongRE ? 1 : 0);
+  gl.Uniform1i(u.ggx, o.lobe == LobeForm::GgxNH ? 1 : 0);
 }
 
 // End of the batch starting at vertex `first`: at most batch_vertices vertices and batch_bytes of

@@ -38,7 +38,7 @@ constexpr float kFitDiffuseThreshold = 0.2f;
 // The product's lobe form (the filter's and vbrdf_fit's default; README "The lobe's form and several
 // cameras" has the measurements that chose it). PhongFitOptions keeps the thesis's R.E as the
 // core contract's default; the pipeline copies phong.lobe into gather.lobe.
-constexpr LobeForm kFitLobe = LobeForm::BlinnNH;
+constexpr LobeForm kFitLobe = LobeForm::GgxNH;
 
 // How the fit's diffuse form (diffuse_form.h) is decided. Auto (the product's default): a pilot fit
 // on each form with photos held out picks it per scene (diffuse_choice.h; README "The diffuse

@@ -60,9 +60,9 @@ std::vector<ResultAttribute> make_schema() {
        "material found from the data (materials = on): 1..K, listed in the report; 0 none (stage off, or no model)",
        [](const R &r) { return r.material; }, [](R &r, float v) { r.material = whole(v, 65535.0f); }},
       {"lobe_form", K::Code, G::PhongFit, false,
-       "the specular lobe's form that shininess applies to: 0 Phong on R.E (the thesis), 1 Blinn-Phong on N.H "
-       "(absent: 0)",
-       [](const R &r) { return r.lobe_form; }, [](R &r, float v) { r.lobe_form = whole(v, 1.0f); }},
+       "the specular lobe's form that shininess applies to: 0 Phong on R.E (the thesis), 1 Blinn-Phong on N.H, "
+       "2 GGX on N.H with roughness sqrt(2 / (shininess + 2)) (absent: 0)",
+       [](const R &r) { return r.lobe_form; }, [](R &r, float v) { r.lobe_form = whole(v, float(kLobeFormCount - 1)); }},
       {"diffuse_form", K::Code, G::PhongFit, false,
        "the diffuse term's form that kd multiplies at the vertex: 0 Lambert (N.L, the thesis), 1 coated (N.L with "
        "a clear coat's Fresnel transmission in and out, index 1.5) (absent: 0)",
@@ -123,12 +123,15 @@ std::vector<VertexRecord> records_from_columns(const ResultColumns &columns, con
 }
 
 LobeForm lobe_form_of(const std::vector<VertexRecord> &records, const std::string &source) {
-  bool seen[2] = {false, false};
+  bool seen[kLobeFormCount] = {};
   for (const VertexRecord &r : records)
-    if (has_model(r.fit)) seen[r.lobe_form > 0.5f ? 1 : 0] = true;
-  if (seen[0] && seen[1])
-    throw InputError("Result '" + source + "' mixes lobe forms (per-vertex 'lobe_form' 0 and 1): refit it in one run.");
-  return seen[1] ? LobeForm::BlinnNH : LobeForm::PhongRE;
+    if (has_model(r.fit)) seen[int(std::lround(std::min(std::max(r.lobe_form, 0.0f), float(kLobeFormCount - 1))))] = true;
+  int form = 0, forms = 0;
+  for (int f = 0; f < kLobeFormCount; ++f)
+    if (seen[f]) form = f, ++forms;
+  if (forms > 1)
+    throw InputError("Result '" + source + "' mixes lobe forms (per-vertex 'lobe_form' takes several of 0, 1, 2): refit it in one run.");
+  return LobeForm(form);
 }
 
 DiffuseForms diffuse_forms_of(const std::vector<VertexRecord> &records) {

@@ -19,7 +19,8 @@ std::string phong_program_source(const char *body) {
 }
 
 void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe) {
-  gl.Uniform1i(gl.GetUniformLocation(program, "u_half_angle_lobe"), lobe == LobeForm::BlinnNH ? 1 : 0);
+  gl.Uniform1i(gl.GetUniformLocation(program, "u_half_angle_lobe"), lobe != LobeForm::PhongRE ? 1 : 0);
+  gl.Uniform1i(gl.GetUniformLocation(program, "u_ggx_lobe"), lobe == LobeForm::GgxNH ? 1 : 0);
   gl.Uniform1f(gl.GetUniformLocation(program, "u_coat_index"), kCoatIndex);
   gl.Uniform1f(gl.GetUniformLocation(program, "u_coat_min_cosine"), kCoatMinCosine);
 }
