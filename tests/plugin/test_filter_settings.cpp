@@ -152,7 +152,7 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
   rejects("memoryBudgetMB", IntValue(8));
   rejects("initialShininess", FloatValue(0.5f));
   rejects("maxIterations", IntValue(-1));
-  rejects("specularLobe", EnumValue(2));
+  rejects("specularLobe", EnumValue(3));
   rejects("diffuseTerm", EnumValue(3));
   rejects("diffuseTerm", EnumValue(-1));
   rejects("domeRadius", FloatValue(-1.0f));
