@@ -60,7 +60,7 @@ struct Static {
   uint32_t n = 0, n_high = 0;
   uint32_t n_flank = 0;  // samples in the lobe's flank (MaterialOptions::deciding_flank)
 };
-// Lobe sums at one alpha: b = sum w d g, g2 = sum w g^2, q_c = sum w g P_c, g = s^alpha.
+// Lobe sums at one alpha: b = sum w d g, g2 = sum w g^2, q_c = sum w g P_c, g = the lobe g(s, alpha).
 struct Lobe {
   double b = 0, g2 = 0, q[3] = {0, 0, 0};
 };
@@ -71,7 +71,7 @@ struct Context {
   const MaterialOptions &mo;
   // Per entry, the lobe's key x (lobe_key): +1 for s <= 0 (no lobe); else ln(min(s, 1)) for the
   // power forms, -(1 - s^2) for GGX (both <= 0).
-  const std::vector<float> *log_s = nullptr;
+  const std::vector<float> *lobe_keys = nullptr;
   std::vector<uint8_t> eligible;  // per vertex: refitted by the material stage
   size_t n = 0;
   bool subsampled = false;    // eligible is a subsample of the stage's vertices (selection_subsample)
@@ -84,7 +84,7 @@ struct Context {
   }
 };
 
-// The entry key of Context::log_s for a lobe cosine s.
+// The entry key of Context::lobe_keys for a lobe cosine s.
 inline float lobe_key(float s, bool ggx) {
   if (!(s > 0)) return 1.0f;
   s = std::min(s, 1.0f);
@@ -151,7 +151,7 @@ void lobe_sums(const Context &c, int set, const std::vector<int32_t> &label, con
     for (uint64_t k = c.store.first(size_t(v)); k < c.store.last(size_t(v)); ++k) {
       const Entry &e = E[k];
       if (!c.in_set(e, set)) continue;
-      const double g = lobe_of((*c.log_s)[k], alpha, c.ggx);
+      const double g = lobe_of((*c.lobe_keys)[k], alpha, c.ggx);
       if (g != 0) add_to_lobe(L, e, g);
     }
   }
@@ -229,7 +229,7 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
       Lobe *Lv = &L[size_t(t) * ng];
       for (uint64_t k = c.store.first(v); k < c.store.last(v); ++k) {
         const Entry &e = entries[k];
-        const float ls = (*c.log_s)[k];
+        const float ls = (*c.lobe_keys)[k];
         if (ls > 0 || !c.in_set(e, set)) continue;
         for (size_t i = 0; i < ng; ++i)
           g[i] = squared[i] ? square_lobe(g[i - kGridStepsPerDoubling]) : lobe_of(ls, grid[i], c.ggx);
@@ -590,12 +590,12 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
     for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
       const Entry &e = E[i];
       const bool f = c.in_set(e, fit_set), sc = c.in_set(e, score_set);
-      if ((!f && !sc) || (*c.log_s)[i] > 0) continue;
+      if ((!f && !sc) || (*c.lobe_keys)[i] > 0) continue;
       if (doubling && !centre_only) {  // 4 exponentials, the rest by squaring: s^(2 alpha) = (s^alpha)^2
-        for (int k = 0; k < 4; ++k) g_of[k] = lobe_of((*c.log_s)[i], alpha[k], false);
+        for (int k = 0; k < 4; ++k) g_of[k] = lobe_of((*c.lobe_keys)[i], alpha[k], false);
         for (int k = 4; k < kAlphaSteps; ++k) g_of[k] = square_lobe(g_of[k - 4]);
       } else {
-        for (int k = k_first; k <= k_last; ++k) g_of[k] = lobe_of((*c.log_s)[i], alpha[k], c.ggx);
+        for (int k = k_first; k <= k_last; ++k) g_of[k] = lobe_of((*c.lobe_keys)[i], alpha[k], c.ggx);
       }
       for (int k = k_first; k <= k_last; ++k) {
         const double g = g_of[k];
@@ -666,7 +666,7 @@ void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[
   std::vector<double> res;
   for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
     const Entry &e = E[i];
-    const double g = ks > 0 ? ks * lobe_of((*c.log_s)[i], alpha, c.ggx) : 0.0;
+    const double g = ks > 0 ? ks * lobe_of((*c.lobe_keys)[i], alpha, c.ggx) : 0.0;
     double r = 0;
     for (int ch = 0; ch < 3; ++ch) r += std::fabs(e.rgb[ch] - rho[ch] * e.d - g);
     res.push_back(r / 3);
@@ -682,7 +682,7 @@ void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[
   for (uint64_t i = c.store.first(v), j = 0; i < c.store.last(v); ++i, ++j) {
     if (std::fabs(res[j] - med) > 3 * mad) continue;
     const Entry &e = E[i];
-    const double g = ks > 0 ? ks * lobe_of((*c.log_s)[i], alpha, c.ggx) : 0.0;
+    const double g = ks > 0 ? ks * lobe_of((*c.lobe_keys)[i], alpha, c.ggx) : 0.0;
     a += double(e.w) * e.d * e.d;
     for (int ch = 0; ch < 3; ++ch) p[ch] += double(e.w) * e.d * (e.rgb[ch] - g);
     ++kept;
@@ -761,10 +761,10 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     R.report = "materials: no vertex with samples: stage skipped\n";
     return R;
   }
-  std::vector<float> log_s(store.entries().size());
+  std::vector<float> lobe_keys(store.entries().size());
   c.ggx = o.lobe == LobeForm::GgxNH;
-  for (size_t k = 0; k < log_s.size(); ++k) log_s[k] = lobe_key(store.entries()[k].s, c.ggx);
-  c.log_s = &log_s;
+  for (size_t k = 0; k < lobe_keys.size(); ++k) lobe_keys[k] = lobe_key(store.entries()[k].s, c.ggx);
+  c.lobe_keys = &lobe_keys;
   const Adjacency adj = build_mesh_adjacency(mesh);
   std::ostringstream rep;
 
