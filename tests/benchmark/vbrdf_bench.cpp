@@ -285,12 +285,17 @@ HeldOut load_heldout(const Args &a, const MeshData &mesh) {
 // every seen, lit, unsaturated vertex sample, the held-out photo sampled bilinearly at the
 // vertex's pixel, vertices without a model black) beside per-pixel PTM and Relight-style RBF fitted
 // on the training photos of the same camera and scored on the same samples (relight.h).
-void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<VertexFit> &fits,
-                      const std::vector<Raster> &training, const std::vector<LightSource> &training_lights,
-                      const GetProcAddressFn &get_proc, Json &out) {
+// `lobe`, `diffuse`: the forms the fit used (FitSettings::phong.lobe, FitRunResult::diffuse_forms):
+// the renderer and the sample-based evaluation must evaluate the model the fit made.
+void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<VertexFit> &fits, LobeForm lobe,
+                      const DiffuseForms &diffuse, const std::vector<Raster> &training,
+                      const std::vector<LightSource> &training_lights, const GetProcAddressFn &get_proc, Json &out) {
   const HeldOut h = load_heldout(a, mesh);
   const auto t = Clock::now();
-  RelightRenderer renderer(mesh.view(), fits, get_proc);
+  RelightRenderSettings render_settings;
+  render_settings.lobe = lobe;
+  render_settings.diffuse = diffuse;
+  RelightRenderer renderer(mesh.view(), fits, get_proc, render_settings);
   RelightOutputOptions options;
   options.folder = a.get("relight-dir");
   const RelightReport report = relight_rasters(renderer, h.rasters, h.lights, options);
@@ -306,6 +311,8 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
     rendered.push_back(render_as_photographed(renderer, h.rasters[r].shot, h.lights[r]));
   auto visibility = make_gl_visibility(mesh.view(), get_proc, VisibilitySettings());
   RelightOptions ro;
+  ro.gather.lobe = lobe;  // the samples' lobe cosine and diffuse factor in the fit's forms
+  ro.gather.diffuse = diffuse;
   ro.rendered = &rendered;
   ro.training_rasters = &training;
   ro.training_lights = &training_lights;
@@ -386,7 +393,7 @@ int cmd_fit(const Args &a) {
   out.num("converged", double(r.fit_converged));
   out.num("alpha_iterations", double(r.fit_iterations));
   if (!a.get("heldout").empty())
-    evaluate_heldout(a, mesh, r.fits, input.rasters,
+    evaluate_heldout(a, mesh, r.fits, settings.phong.lobe, r.diffuse_forms, input.rasters,
                      resolve_lights(input.rasters, r.light_file,
                                     light_placement_of(mesh.view(), 0.0f, 0.0f)),
                      get_proc, out);
