@@ -26,60 +26,13 @@ scenes with directional lights). Figures: README, "What the true reflectance sco
 """
 import csv
 import json
+import os
 import sys
 
 import numpy as np
 
-M = np.array([[0.4124564, 0.3575761, 0.1804375],
-              [0.2126729, 0.7151522, 0.0721750],
-              [0.0193339, 0.1191920, 0.9503041]])
-WHITE = M.sum(axis=1)
-
-
-def lab(rgb):
-    xyz = rgb @ M.T / WHITE
-    d = 6.0 / 29.0
-    f = np.where(xyz > d ** 3, np.cbrt(xyz), xyz / (3 * d * d) + 4.0 / 29.0)
-    return np.stack([116 * f[:, 1] - 16, 500 * (f[:, 0] - f[:, 1]), 200 * (f[:, 1] - f[:, 2])], axis=1)
-
-
-def ciede2000(lab1, lab2):
-    L1, a1, b1 = lab1.T
-    L2, a2, b2 = lab2.T
-    cbar = 0.5 * (np.hypot(a1, b1) + np.hypot(a2, b2))
-    g = 0.5 * (1 - np.sqrt(cbar ** 7 / (cbar ** 7 + 25.0 ** 7)))
-    a1p, a2p = (1 + g) * a1, (1 + g) * a2
-    c1p, c2p = np.hypot(a1p, b1), np.hypot(a2p, b2)
-    h1p = np.where((a1p == 0) & (b1 == 0), 0, np.degrees(np.arctan2(b1, a1p)) % 360)
-    h2p = np.where((a2p == 0) & (b2 == 0), 0, np.degrees(np.arctan2(b2, a2p)) % 360)
-    dL, dC = L2 - L1, c2p - c1p
-    dh = h2p - h1p
-    dh = np.where(dh > 180, dh - 360, np.where(dh < -180, dh + 360, dh))
-    dh = np.where(c1p * c2p == 0, 0, dh)
-    dH = 2 * np.sqrt(c1p * c2p) * np.sin(np.radians(dh / 2))
-    Lb, Cb = 0.5 * (L1 + L2), 0.5 * (c1p + c2p)
-    hs = h1p + h2p
-    hb = np.where(np.abs(h1p - h2p) <= 180, 0.5 * hs, np.where(hs < 360, 0.5 * (hs + 360), 0.5 * (hs - 360)))
-    hb = np.where(c1p * c2p == 0, hs, hb)
-    t = (1 - 0.17 * np.cos(np.radians(hb - 30)) + 0.24 * np.cos(np.radians(2 * hb))
-         + 0.32 * np.cos(np.radians(3 * hb + 6)) - 0.20 * np.cos(np.radians(4 * hb - 63)))
-    dtheta = 30 * np.exp(-((hb - 275) / 25) ** 2)
-    rc = 2 * np.sqrt(Cb ** 7 / (Cb ** 7 + 25.0 ** 7))
-    sl = 1 + 0.015 * (Lb - 50) ** 2 / np.sqrt(20 + (Lb - 50) ** 2)
-    sc = 1 + 0.045 * Cb
-    sh = 1 + 0.015 * Cb * t
-    rt = -np.sin(np.radians(2 * dtheta)) * rc
-    return np.sqrt((dL / sl) ** 2 + (dC / sc) ** 2 + (dH / sh) ** 2 + rt * (dC / sc) * (dH / sh))
-
-
-def fresnel_dielectric(cos_i, eta):
-    """Unpolarised Fresnel reflectance from outside into index eta (cos_i > 0)."""
-    cos_i = np.clip(cos_i, 0, 1)
-    sin_t2 = (1 - cos_i ** 2) / eta ** 2
-    cos_t = np.sqrt(np.maximum(1 - sin_t2, 0))
-    rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
-    rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
-    return np.where(sin_t2 >= 1, 1.0, 0.5 * (rs ** 2 + rp ** 2))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
+import e2e_lib as lib  # noqa: E402  (CIELAB, CIEDE2000, Fresnel: the tests' one copy)
 
 
 def ggx_d(cos_h, alpha):
@@ -98,7 +51,7 @@ def spec_value(n_dot_e, n_dot_l, n_dot_h, e_dot_h, alpha, eta):
     """Mitsuba roughplastic's specular eval: D F G / (4 cos_theta_i), i = the view side (f * N.L)."""
     d = ggx_d(n_dot_h, alpha)
     g = smith_g1(n_dot_e, e_dot_h, alpha) * smith_g1(n_dot_l, e_dot_h, alpha)
-    return d * fresnel_dielectric(e_dot_h, eta) * g / (4 * np.maximum(n_dot_e, 1e-9))
+    return d * lib.fresnel_dielectric(e_dot_h, eta) * g / (4 * np.maximum(n_dot_e, 1e-9))
 
 
 def rough_transmittance(mu, alpha, eta, n=192):
@@ -117,11 +70,6 @@ def rough_transmittance(mu, alpha, eta, n=192):
         v = spec_value(m, wo[..., 2], h[..., 2], h @ wi, alpha, eta)
         out.append(1 - np.sum(v * dw))
     return np.array(out)
-
-
-def load_lp(path):
-    rows = [l.split() for l in open(path).read().splitlines()[1:] if l.strip()]
-    return {r[0].split('/')[-1]: np.array([float(x) for x in r[1:4]]) for r in rows}
 
 
 def main(argv):
@@ -175,8 +123,8 @@ def main(argv):
     lit = gt["heldout_lit"][v, j]
     truth = exposure * irradiance * (gt["albedo_effective_normal"][v] * diff[:, None] + spec[:, None]) * lit[:, None]
     truth = np.minimum(truth, 1.0)
-    de_prod = ciede2000(lab(obs), lab(np.minimum(pred, 1.0)))
-    de_true = ciede2000(lab(obs), lab(truth))
+    de_prod = lib.ciede2000(lib.linear_rgb_to_lab(obs), lib.linear_rgb_to_lab(np.minimum(pred, 1.0)))
+    de_true = lib.ciede2000(lib.linear_rgb_to_lab(obs), lib.linear_rgb_to_lab(truth))
     check = np.abs(de_prod - de_csv)
     print(f"{len(rows)} samples; this script's CIEDE2000 of the product against vbrdf_eval's: max |diff| {check.max():.4f}")
     if not check.max() < 0.01:

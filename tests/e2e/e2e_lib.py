@@ -204,6 +204,17 @@ def ciede2000(lab1, lab2):
     return np.sqrt((dLp / Sl) ** 2 + (dCp / Sc) ** 2 + (dHp / Sh) ** 2 + Rt * (dCp / Sc) * (dHp / Sh))
 
 
+def fresnel_dielectric(cos_i, eta):
+    """Unpolarised Fresnel reflectance of a dielectric of relative index eta seen from outside, at
+    incidence cosine cos_i (clipped to [0, 1]; total internal reflection gives 1)."""
+    cos_i = np.clip(np.asarray(cos_i, np.float64), 0, 1)
+    sin_t2 = (1 - cos_i ** 2) / eta ** 2
+    cos_t = np.sqrt(np.maximum(1 - sin_t2, 0))
+    rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
+    rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
+    return np.where(sin_t2 >= 1, 1.0, 0.5 * (rs ** 2 + rp ** 2))
+
+
 def fit_colour_map(est, gt, mode):
     """Least-squares map M with est @ M.T ~ gt: 'scalar' (s*I), 'diag' (per channel) or 'matrix'
     (3x3). Reflectance is known up to the unknown light intensity/exposure (scalar) and, for

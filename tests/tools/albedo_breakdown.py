@@ -33,15 +33,6 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import e2e_lib as lib  # noqa: E402
 
 
-def fresnel_dielectric(cos_i, eta):
-    """Unpolarised Fresnel reflectance of a dielectric (relative IOR eta > 1) seen from outside."""
-    sin_t2 = (1.0 - cos_i ** 2) / eta ** 2
-    cos_t = np.sqrt(np.maximum(1.0 - sin_t2, 0.0))
-    rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
-    rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
-    return 0.5 * (rs ** 2 + rp ** 2)
-
-
 def neighbour_jump(faces, lab):
     """Per vertex, the largest CIEDE2000 between its colour and a mesh neighbour's."""
     i = np.concatenate([faces[:, 0], faces[:, 1], faces[:, 2], faces[:, 1], faces[:, 2], faces[:, 0]])
@@ -147,7 +138,7 @@ def main(argv):
     score(e1b, "rims x 1.06 (the Lambertian rims' deficit: background mixing)")
     e2 = est.copy(); e2[edge] = gt[edge] * ref
     score(e2, "albedo-edge vertices perfect")
-    t_rel = (1 - fresnel_dielectric(np.clip(n_dot_e, 0.15, 1.0), ior)) / (1 - fresnel_dielectric(np.ones(1), ior))
+    t_rel = (1 - lib.fresnel_dielectric(np.clip(n_dot_e, 0.15, 1.0), ior)) / (1 - lib.fresnel_dielectric(np.ones(1), ior))
     e3 = est.copy(); e3[glossy] /= t_rel[glossy, None]
     score(e3, f"glossy (truth) / T(theta_o)/T(0), IOR {ior:g}, N.E >= 0.15")
     e4 = est / t_rel[:, None]
