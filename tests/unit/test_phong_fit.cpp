@@ -107,7 +107,8 @@ TEST(PhongFit, TooFewHighlightsGiveDiffuseOnly) {
 
 namespace {
 // Samples of one vertex (normal +z) seen from a camera direction `e`, under `n` lights spread over
-// the hemisphere, whose true lobe is ks (N.H)^alpha; the sample's cosine is in the form `form`.
+// the hemisphere, whose true lobe is ks g(N.H, alpha) of the form `truth` (lobe_value); the sample's
+// cosine is in the form `form`.
 std::vector<Sample> half_angle_vertex(const float e[3], float alpha, LobeForm form, std::mt19937 &rng, int n = 200,
                                       LobeForm truth = LobeForm::BlinnNH) {
   std::uniform_real_distribution<float> u(0, 1);
@@ -138,53 +139,49 @@ std::vector<Sample> half_angle_vertex(const float e[3], float alpha, LobeForm fo
   }
   return out;
 }
+// One vertex whose true lobe is `truth` (alpha 120, k_s 0.8, rho_r 0.3; half_angle_vertex), seen
+// from `e`, fitted in its own form and in a `rival` form (each sample's cosine in the fitted form,
+// the same lights): the own form recovers the parameters and fits exactly, the rival cannot follow
+// the lobe and leaves a residual. Returns the own form's fit.
+VertexFit expect_form_recovered_and_rival_worse(LobeForm truth, LobeForm rival, const float e[3], unsigned seed) {
+  PhongFitOptions own, other;
+  own.lobe = truth;
+  other.lobe = rival;
+  std::mt19937 rng(seed);
+  const std::vector<Sample> s_own = half_angle_vertex(e, 120, truth, rng, 200, truth);
+  rng.seed(seed);
+  const std::vector<Sample> s_rival = half_angle_vertex(e, 120, rival, rng, 200, truth);
+  VertexFit f_own, f_rival;
+  fit_vertex_cpu(s_own.data(), s_own.size(), own, f_own);
+  fit_vertex_cpu(s_rival.data(), s_rival.size(), other, f_rival);
+  EXPECT_EQ(f_own.status, kFitFull);
+  EXPECT_NEAR(f_own.shininess, 120, 120 * 0.02);
+  EXPECT_NEAR(f_own.ks, 0.8, 0.8 * 0.02);
+  EXPECT_NEAR(f_own.kd * f_own.color[0], 0.3, 0.01);
+  EXPECT_LT(f_own.rmse, 1e-3);
+  EXPECT_GT(f_rival.rmse, 5 * f_own.rmse + 1e-3)
+      << lobe_form_label(rival) << " fits the " << lobe_form_label(truth) << " lobe as well: the test cannot tell the forms apart";
+  return f_own;
+}
 } // namespace
 
 // A GGX highlight (the microfacet lobe, long tails): the GGX form recovers its roughness (as the
 // Phong-equivalent exponent) and k_s and fits it exactly; Blinn-Phong, whose (N.H)^alpha has no such
 // tails, cannot, and leaves a residual.
 TEST(PhongFit, GgxLobeIsRecoveredAndFitsBetterThanBlinnPhong) {
-  std::mt19937 rng(9);
   const float e[3] = {0.5f, 0, 0.8660254f};  // 30 degrees off the normal
-  PhongFitOptions ggx, nh;
-  ggx.lobe = LobeForm::GgxNH;
-  nh.lobe = LobeForm::BlinnNH;
-  const std::vector<Sample> s = half_angle_vertex(e, 120, LobeForm::GgxNH, rng, 200, LobeForm::GgxNH);
-  VertexFit f_ggx, f_nh;
-  fit_vertex_cpu(s.data(), s.size(), ggx, f_ggx);
-  fit_vertex_cpu(s.data(), s.size(), nh, f_nh);
-  ASSERT_EQ(f_ggx.status, kFitFull);
-  EXPECT_NEAR(f_ggx.shininess, 120, 120 * 0.02);
-  EXPECT_NEAR(f_ggx.ks, 0.8, 0.8 * 0.02);
-  EXPECT_NEAR(f_ggx.kd * f_ggx.color[0], 0.3, 0.01);
-  EXPECT_LT(f_ggx.rmse, 1e-3);
-  EXPECT_GT(f_nh.rmse, 5 * f_ggx.rmse + 1e-3) << "Blinn-Phong fits the GGX lobe as well: the test cannot tell the forms apart";
+  const VertexFit f = expect_form_recovered_and_rival_worse(LobeForm::GgxNH, LobeForm::BlinnNH, e, 9);
   float out[3];
-  evaluate_phong(f_ggx, 0.5f, 1.0f, LobeForm::GgxNH, out);  // at the lobe's peak: k_d C d + k_s
-  EXPECT_NEAR(out[0], f_ggx.kd * f_ggx.color[0] * 0.5f + f_ggx.ks, 1e-5);
+  evaluate_phong(f, 0.5f, 1.0f, LobeForm::GgxNH, out);  // at the lobe's peak: k_d C d + k_s
+  EXPECT_NEAR(out[0], f.kd * f.color[0] * 0.5f + f.ks, 1e-5);
 }
 
 // A Blinn-Phong highlight seen away from the camera axis: the N.H form recovers its exponent and
 // fits it exactly; the thesis's R.E form cannot follow it (the R-E and N-H angles are tied only in
 // the plane of incidence) and leaves a residual.
 TEST(PhongFit, HalfAngleLobeIsRecoveredAndFitsBetterThanMirrorLobe) {
-  std::mt19937 rng(5);
   const float e[3] = {0.7071068f, 0, 0.7071068f};  // 45 degrees off the normal
-  PhongFitOptions nh, re;
-  nh.lobe = LobeForm::BlinnNH;
-  re.lobe = LobeForm::PhongRE;
-  const std::vector<Sample> s_nh = half_angle_vertex(e, 120, LobeForm::BlinnNH, rng);
-  rng.seed(5);
-  const std::vector<Sample> s_re = half_angle_vertex(e, 120, LobeForm::PhongRE, rng);
-  VertexFit f_nh, f_re;
-  fit_vertex_cpu(s_nh.data(), s_nh.size(), nh, f_nh);
-  fit_vertex_cpu(s_re.data(), s_re.size(), re, f_re);
-  ASSERT_EQ(f_nh.status, kFitFull);
-  EXPECT_NEAR(f_nh.shininess, 120, 120 * 0.02);
-  EXPECT_NEAR(f_nh.ks, 0.8, 0.8 * 0.02);
-  EXPECT_NEAR(f_nh.kd * f_nh.color[0], 0.3, 0.01);
-  EXPECT_LT(f_nh.rmse, 1e-3);
-  EXPECT_GT(f_re.rmse, 5 * f_nh.rmse + 1e-3) << "R.E fits the N.H lobe as well: the test cannot tell the forms apart";
+  const VertexFit f_nh = expect_form_recovered_and_rival_worse(LobeForm::BlinnNH, LobeForm::PhongRE, e, 5);
   EXPECT_GT(f_nh.sq, 0);  // SQ's sampling term on the R.E scale (2 c^2 - 1)
   EXPECT_LE(f_nh.sq, 2);
 }

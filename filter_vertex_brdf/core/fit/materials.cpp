@@ -94,10 +94,7 @@ inline float lobe_key(float s, bool ggx) {
 // The lobe g(s, alpha) from the entry key (samples/lobe.h lobe_value, the same values).
 inline double lobe_of(float key, double alpha, bool ggx) {
   if (key > 0) return 0;
-  if (ggx) {
-    const double a2 = 2.0 / (alpha + 2.0), r = a2 / (a2 - double(key) * (1 - a2));
-    return r * r;
-  }
+  if (ggx) return ggx_lobe_of_u(-double(key), alpha);
   return std::exp(std::max(alpha * double(key), -80.0));
 }
 

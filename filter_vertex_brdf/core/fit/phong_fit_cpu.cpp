@@ -15,10 +15,8 @@ struct FitSample {
   double ln_s = 0;  // ln(min(s, 1)) where s > 0 (with_ln_s): the lobe's iterations need no log
 };
 
-// The lobe g(s, alpha) of the form (samples/lobe.h lobe_value).
-inline double lobe(LobeForm form, double s, double alpha) { return lobe_value(form, s, alpha); }
-
-// The same for a fit sample; power forms from its stored logarithm (bit for bit lobe_value's).
+// The lobe g(s, alpha) of the form for a fit sample (samples/lobe.h lobe_value); power forms from
+// its stored logarithm (bit for bit lobe_value's).
 inline double lobe(LobeForm form, const FitSample &x, double alpha) {
   if (!lobe_is_power(form)) return lobe_value(form, x.s, alpha);
   return x.s > 0 ? std::exp(std::max(alpha * x.ln_s, -80.0)) : 0.0;
@@ -196,7 +194,7 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 
 void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out[3]) {
   const float d = std::max(d_in, 0.0f);
-  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe(form, lobe_cos, fit.shininess)) : 0.0f;
+  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe_value(form, lobe_cos, fit.shininess)) : 0.0f;
   for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
 }
 

@@ -48,6 +48,12 @@ inline bool parse_lobe_form(const std::string &text, LobeForm &out) {
 // True for the forms whose g is s^alpha (the fits' ln s shortcuts and s^(2 alpha) = (s^alpha)^2).
 inline bool lobe_is_power(LobeForm f) { return f != LobeForm::GgxNH; }
 
+// The GGX lobe from u = 1 - s^2 in [0, 1] (the material stage keeps u per sample): in (0, 1], 1 at u = 0.
+inline double ggx_lobe_of_u(double u, double alpha) {
+  const double a2 = 2.0 / (alpha + 2.0), r = a2 / (a2 + u * (1 - a2));
+  return r * r;
+}
+
 // g(s, alpha) of the form (see the header comment), for alpha >= 0. s <= 0 gives 0; s is clamped at
 // 1. Power forms: exp(max(alpha ln s, -80)) (no ln 0, no overflow, no denormals). GGX: a^2 in
 // (0, 1] for alpha >= 0, the denominator >= a^2 > 0, so g is in (0, 1] for s > 0 (never 0: the
@@ -59,8 +65,7 @@ inline double lobe_value(LobeForm f, double s, double alpha) {
     const double x = alpha * std::log(s);
     return std::exp(x > -80.0 ? x : -80.0);
   }
-  const double a2 = 2.0 / (alpha + 2.0), r = a2 / (a2 + (1 - s * s) * (1 - a2));
-  return r * r;
+  return ggx_lobe_of_u(1 - s * s, alpha);
 }
 
 // d g / d ln(alpha) at (s, alpha): the fits' Newton step on t = ln alpha. 0 for s <= 0 or s >= 1.
