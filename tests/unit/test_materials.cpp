@@ -193,6 +193,52 @@ TEST(Materials, NoSamplesLeaveTheFitsAlone) {
   for (int32_t l : r.label) EXPECT_EQ(l, 0);
 }
 
+// With no glossy material at all (every material diffuse: the real photometric-stereo objects pool
+// into one material whose lobe explains 1-2 % of the energy), a vertex's own highlights are the only
+// specular evidence: the stage keeps every vertex's own fit instead of stripping its lobe.
+TEST(Materials, WithoutAGlossyMaterialOwnLobesAreKept) {
+  const Scene sc = make_scene(false, 0.0f, 30.0f, 5);  // a matte object
+  PhongFitOptions o;
+  o.lobe = LobeForm::GgxNH;
+  std::vector<VertexFit> before(sc.chunk.vertex_count);
+  fit_chunk_cpu(sc.chunk, o, before.data());
+  size_t own = 0;
+  for (size_t v = 0; v < before.size(); v += 10)  // as if these vertices' own photos showed a highlight
+    if (before[v].status == kFitDiffuseOnly) before[v].status = kFitFull, before[v].ks = 0.2f, before[v].shininess = 40.0f, ++own;
+  ASSERT_GT(own, 20u);
+  std::vector<VertexFit> after = before;
+  MaterialSampleStore store(sc.chunk.vertex_count);
+  store.add_chunk(sc.chunk, before.data(), o);
+  const MaterialResult r = fit_materials(sc.mesh.view(), store, o, MaterialOptions(), nullptr, nullptr, after);
+  ASSERT_GE(r.chosen_k, 1);
+  for (const Material &m : r.materials) ASSERT_TRUE(m.diffuse) << r.report;
+  EXPECT_EQ(r.vertices_set_diffuse, 0u) << r.report;
+  for (size_t v = 0; v < before.size(); ++v) {
+    EXPECT_EQ(after[v].ks, before[v].ks) << "vertex " << v;
+    EXPECT_EQ(after[v].kd, before[v].kd) << "vertex " << v;
+    EXPECT_EQ(after[v].status, before[v].status) << "vertex " << v;
+  }
+  EXPECT_NE(r.report.find("no glossy material"), std::string::npos) << r.report;
+}
+
+// A glossy material gives its lobe to its lobeless vertices only where that clearly lowers their
+// held-out error (min_giving_gain): demanding an impossible gain leaves every vertex its own fit.
+TEST(Materials, LobesAreGivenOnlyWhereTheHeldOutPhotosSayTheyHelp) {
+  const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
+  const StageRun given = run_stage(sc);
+  ASSERT_GT(given.result.vertices_changed_to_specular, 0u) << given.result.report;
+  EXPECT_NE(given.result.report.find(": given"), std::string::npos) << given.result.report;
+  MaterialOptions strict;
+  strict.min_giving_gain = 1.0f;  // the lobe would have to explain every held-out residual
+  const StageRun kept = run_stage(sc, strict);
+  EXPECT_EQ(kept.result.vertices_changed_to_specular, 0u) << kept.result.report;
+  EXPECT_NE(kept.result.report.find("NOT given"), std::string::npos) << kept.result.report;
+  for (size_t v = 0; v < sc.truth.size(); ++v) {
+    const Material &m = kept.result.materials[size_t(kept.result.label[v]) - 1];
+    if (!m.diffuse && !(kept.before[v].ks > 0)) EXPECT_EQ(kept.after[v].ks, 0.0f) << "vertex " << v;
+  }
+}
+
 TEST(Materials, ByDefaultOwnLobesAreKeptAndTheOthersGetTheMaterials) {
   const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
   const StageRun r = run_stage(sc);

@@ -2,8 +2,10 @@
 // vertex gets a model; unseen ones only on request.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "base/mesh_adjacency.h"
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
 #include "test_scenes.h"
@@ -135,6 +137,24 @@ TEST(WeakFit, GrazingOrMixedOnlyVerticesStillGetAModel) {
   fit_vertex_weak(dark.data(), dark.size(), PhongFitOptions(), weak);
   EXPECT_EQ(weak.status, kFitNone);
   EXPECT_EQ(weak.kd, 0.0f);
+}
+
+// The material stage stops spreading labels where no labelled vertex can reach (materials.cpp):
+// it needs each vertex's connected component.
+TEST(MeshAdjacency, ConnectedComponentsNumberedByTheirLowestVertex) {
+  MeshData mesh;
+  mesh.positions.assign(3 * 8, 0.0f);
+  // vertex 0 isolated; 1-2-3 a triangle; 4-5-6 and 5-6-7 two triangles sharing an edge
+  mesh.indices = {1, 2, 3, 4, 5, 6, 5, 7, 6};
+  uint32_t count = 0;
+  const std::vector<uint32_t> comp = connected_components(build_mesh_adjacency(mesh.view()), &count);
+  EXPECT_EQ(count, 3u);
+  EXPECT_EQ(comp, (std::vector<uint32_t>{0, 1, 1, 1, 2, 2, 2, 2}));
+  // and a grid is one component
+  const MeshData grid = test::make_grid(4, 1.0f, 0.0f);
+  const std::vector<uint32_t> one = connected_components(build_mesh_adjacency(grid.view()), &count);
+  EXPECT_EQ(count, 1u);
+  EXPECT_TRUE(std::all_of(one.begin(), one.end(), [](uint32_t c) { return c == 0; }));
 }
 
 } // namespace

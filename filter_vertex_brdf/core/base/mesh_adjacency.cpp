@@ -38,4 +38,25 @@ MeshAdjacency build_mesh_adjacency(const MeshView &mesh) {
   return adj;
 }
 
+std::vector<uint32_t> connected_components(const MeshAdjacency &adj, uint32_t *count) {
+  const size_t n = adj.vertex_count();
+  constexpr uint32_t kNone = UINT32_MAX;
+  std::vector<uint32_t> comp(n, kNone), stack;
+  uint32_t next = 0;
+  for (size_t seed = 0; seed < n; ++seed) {
+    if (comp[seed] != kNone) continue;
+    comp[seed] = next;
+    stack.assign(1, uint32_t(seed));
+    while (!stack.empty()) {
+      const uint32_t v = stack.back();
+      stack.pop_back();
+      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
+        if (comp[adj.neighbours[k]] == kNone) comp[adj.neighbours[k]] = next, stack.push_back(adj.neighbours[k]);
+    }
+    ++next;
+  }
+  if (count) *count = next;
+  return comp;
+}
+
 } // namespace vbrdf

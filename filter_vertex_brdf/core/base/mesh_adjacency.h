@@ -18,4 +18,8 @@ struct MeshAdjacency {
 
 MeshAdjacency build_mesh_adjacency(const MeshView &mesh);
 
+// The connected component of every vertex: 0..count-1, numbered in order of their lowest vertex
+// (an isolated vertex is a component of its own). O(vertices + edges).
+std::vector<uint32_t> connected_components(const MeshAdjacency &adj, uint32_t *count = nullptr);
+
 } // namespace vbrdf

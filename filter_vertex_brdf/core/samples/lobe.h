@@ -48,11 +48,16 @@ inline bool parse_lobe_form(const std::string &text, LobeForm &out) {
 // True for the forms whose g is s^alpha (the fits' ln s shortcuts and s^(2 alpha) = (s^alpha)^2).
 inline bool lobe_is_power(LobeForm f) { return f != LobeForm::GgxNH; }
 
-// The GGX lobe from u = 1 - s^2 in [0, 1] (the material stage keeps u per sample): in (0, 1], 1 at u = 0.
-inline double ggx_lobe_of_u(double u, double alpha) {
-  const double a2 = 2.0 / (alpha + 2.0), r = a2 / (a2 + u * (1 - a2));
+// GGX's squared roughness a^2 for a Phong-equivalent exponent alpha >= 0: in (0, 1].
+inline double ggx_a2(double alpha) { return 2.0 / (alpha + 2.0); }
+// The GGX lobe from u = 1 - s^2 in [0, 1] and a2 = ggx_a2(alpha) (loops over many samples at one
+// alpha compute a2 once): in (0, 1], 1 at u = 0.
+inline double ggx_lobe_of_u_a2(double u, double a2) {
+  const double r = a2 / (a2 + u * (1 - a2));
   return r * r;
 }
+// The GGX lobe from u = 1 - s^2 in [0, 1] (the material stage keeps u per sample): in (0, 1], 1 at u = 0.
+inline double ggx_lobe_of_u(double u, double alpha) { return ggx_lobe_of_u_a2(u, ggx_a2(alpha)); }
 
 // g(s, alpha) of the form (see the header comment), for alpha >= 0. s <= 0 gives 0; s is clamped at
 // 1. Power forms: exp(max(alpha ln s, -80)) (no ln 0, no overflow, no denormals). GGX: a^2 in
