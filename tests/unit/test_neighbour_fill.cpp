@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "base/mesh_adjacency.h"
+#include "fit/label_spread.h"
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
 #include "test_scenes.h"
@@ -155,6 +156,38 @@ TEST(MeshAdjacency, ConnectedComponentsNumberedByTheirLowestVertex) {
   const std::vector<uint32_t> one = connected_components(build_mesh_adjacency(grid.view()), &count);
   EXPECT_EQ(count, 1u);
   EXPECT_TRUE(std::all_of(one.begin(), one.end(), [](uint32_t c) { return c == 0; }));
+}
+
+// The material stage's label spreading (label_spread.h). A strip of triangles 0..9 (each vertex
+// joined to the next two) and a separate triangle 10-11-12.
+TEST(LabelSpread, RingsVoteAndStopOnceTheKeptVerticesAreReached) {
+  MeshData mesh;
+  mesh.positions.assign(3 * 13, 0.0f);
+  for (uint32_t v = 0; v + 2 < 10; ++v) mesh.indices.insert(mesh.indices.end(), {v, v + 1, v + 2});
+  mesh.indices.insert(mesh.indices.end(), {10, 11, 12});
+  const MeshAdjacency adj = build_mesh_adjacency(mesh.view());
+  uint32_t count = 0;
+  const std::vector<uint32_t> comp = connected_components(adj, &count);
+  ASSERT_EQ(count, 2u);
+  // Labels at both ends: the rings meet in the middle, each vertex voting from the ring before it.
+  std::vector<int32_t> label(13, 0);
+  label[0] = 2, label[9] = 1;
+  std::vector<uint8_t> seeded(13, 0), kept(13, 1);
+  seeded[0] = seeded[9] = 1;
+  SpreadRingCache cache;
+  const SpreadRings &rings = cache.rings(adj, seeded, kept, &comp, count);
+  EXPECT_EQ(rings.ring_end.size(), 2u);  // {1, 2, 7, 8}, {3, 4, 5, 6}: the unseeded triangle does not hold them up
+  EXPECT_EQ(&cache.rings(adj, seeded, kept, &comp, count), &rings);  // the same labelled set: kept, not recomputed
+  spread_along_rings(adj, rings, 2, label);
+  EXPECT_EQ(label, (std::vector<int32_t>{2, 2, 2, 2, 2, 1, 1, 1, 1, 1, 0, 0, 0}));
+  // Only vertices 1 and 2 kept: one ring, the rest of the strip is not walked.
+  std::vector<uint8_t> near(13, 0);
+  near[1] = near[2] = 1;
+  std::vector<uint8_t> one_seed(13, 0);
+  one_seed[0] = 1;
+  const SpreadRings few = spread_rings(adj, one_seed, near, &comp, count);
+  EXPECT_EQ(few.ring_end.size(), 1u);
+  EXPECT_EQ(few.vertices, (std::vector<uint32_t>{1, 2}));
 }
 
 } // namespace

@@ -1,6 +1,7 @@
 #include "fit/materials.h"
 
 #include "base/mesh_adjacency.h"
+#include "fit/label_spread.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,64 +12,10 @@
 
 namespace vbrdf {
 
-// ---- Sample store ----
-
-MaterialSampleStore::MaterialSampleStore(size_t vertex_count) : begin_(vertex_count, 0), end_(vertex_count, 0) {}
-
-namespace {
-// The fit's usable-sample rules (phong_fit_cpu.cpp usable_samples), strict or weak.
-bool kept_sample(const Sample &s, bool weak) {
-  if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.d > 0)) return false;
-  if ((s.flags & kMixedPixel) && !weak) return false;
-  if ((s.flags & kGrazing) && !(s.flags & kHighlight) && !weak) return false;
-  return std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]) && std::isfinite(s.lobe_cos) &&
-         std::isfinite(s.d);
-}
-} // namespace
-
-void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o) {
-  // Counted first, so that the store grows once per chunk (geometrically) rather than by doubling
-  // copies of tens of MB as entries are pushed.
-  const uint32_t count = std::min<uint64_t>(chunk.vertex_count, begin_.size() - std::min<uint64_t>(begin_.size(), chunk.first_vertex));
-  size_t kept = 0;
-  for (uint32_t i = 0; i < count; ++i) {
-    const bool weak = fits[i].status == kFitFromWeakSamples;
-    for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) kept += kept_sample(chunk.samples[k], weak);
-  }
-  if (data_.size() + kept > data_.capacity()) data_.reserve(std::max(data_.size() + kept, data_.capacity() + data_.capacity() / 2));
-  for (uint32_t i = 0; i < count; ++i) {
-    const size_t v = size_t(chunk.first_vertex) + i;
-    const bool weak = fits[i].status == kFitFromWeakSamples;
-    begin_[v] = data_.size();
-    for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
-      const Sample &s = chunk.samples[k];
-      if (!kept_sample(s, weak)) continue;
-      const float w = s.d * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
-      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.d, 1.0f), s.lobe_cos, w, s.raster,
-                       uint16_t(s.flags | s.resolution << 10)});
-    }
-    end_[v] = data_.size();
-  }
-}
-
-std::vector<Sample> MaterialSampleStore::as_samples(size_t v) const {
-  std::vector<Sample> out;
-  for (uint64_t k = begin_[v]; k < end_[v]; ++k) {
-    const Entry &e = data_[k];
-    Sample smp{{e.rgb[0], e.rgb[1], e.rgb[2]}, e.d, e.s, e.raster, 0, 0};
-    smp.flags = e.flags & 0x3FFu;
-    smp.resolution = uint16_t(e.flags >> 10);
-    out.push_back(smp);
-  }
-  return out;
-}
-
 namespace {
 
 using Entry = MaterialSampleStore::Entry;
 enum SampleSet { kAll = 0, kTrain = 1, kHeld = 2 };
-
-struct RingCache;
 
 // Per-vertex sums that do not depend on the lobe: a = sum w d^2, p_c = sum w d P_c, pp_c = sum w P_c^2.
 struct Static {
@@ -96,7 +43,7 @@ struct Context {
   bool ggx = false;  // o.lobe == GgxNH: lobe_of evaluates GGX, and no (s^alpha)^2 shortcut
   const std::vector<uint32_t> *component = nullptr;  // per mesh vertex, its connected component
   uint32_t component_count = 0;
-  RingCache *rings = nullptr;  // spread_labels' rings for this context's vertices (one cache per context)
+  SpreadRingCache *rings = nullptr;  // spread_labels' rings for this context's vertices (one cache per context)
   // Lobe sums buffers of c.n entries reused by the calls of fit_lobes and assign_labels (never both
   // at once): lobe_sums then writes only the entries it computes (one pool per context).
   std::vector<std::vector<Lobe>> *lobe_buffers = nullptr;
@@ -476,91 +423,6 @@ double median_of(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// The rings of spread_labels for one set of labelled vertices (`seeded`): ring 0 is the unlabelled
-// neighbours of the labelled vertices, ring r + 1 the unlabelled, not yet reached neighbours of ring
-// r, in a fixed order. They depend on which vertices are labelled, not on their labels: the stage
-// asks again and again with the same labelled set (its deciding vertices), so they are kept
-// (RingCache) instead of walking the mesh per call. Only the stage's own vertices keep the spread
-// labels, and only those in a connected component with a labelled vertex can get one: the rings stop
-// once none of them waits (on the benchmark scene they reach 84 k of its 100 k vertices all the
-// same: its matte parts are up to 82 rings from a vertex with a highlight).
-struct SpreadRings {
-  std::vector<uint8_t> seeded;      // per mesh vertex: labelled (the key)
-  std::vector<uint32_t> vertices;   // the rings, one after the other
-  std::vector<size_t> ring_end;     // ring r is vertices[ring_end[r - 1] (0 for r = 0), ring_end[r])
-};
-struct RingCache {
-  std::vector<SpreadRings> entries;  // the last few sets asked for (the stage alternates two)
-};
-
-SpreadRings spread_rings(const Context &c, const Adjacency &adj, std::vector<uint8_t> seeded) {
-  const size_t n = adj.vertex_count();
-  SpreadRings R;
-  std::vector<uint8_t> reached = seeded;
-  std::vector<uint32_t> frontier, next_frontier;
-  auto queue_neighbours = [&](size_t v, std::vector<uint32_t> &q) {
-    for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k) {
-      const uint32_t u = adj.neighbours[k];
-      if (!reached[u]) reached[u] = 1, q.push_back(u);
-    }
-  };
-  for (size_t v = 0; v < n; ++v)
-    if (seeded[v]) queue_neighbours(v, frontier);
-  size_t waiting = 0;
-  if (c.component && c.component->size() == n) {
-    std::vector<uint8_t> has_seed(c.component_count, 0);
-    for (size_t v = 0; v < n; ++v)
-      if (seeded[v]) has_seed[(*c.component)[v]] = 1;
-    for (size_t v = 0; v < std::min(n, c.n); ++v) waiting += c.eligible[v] && !seeded[v] && has_seed[(*c.component)[v]];
-  } else {
-    for (size_t v = 0; v < std::min(n, c.n); ++v) waiting += c.eligible[v] && !seeded[v];
-  }
-  std::vector<std::vector<uint32_t>> rings;
-  while (!frontier.empty() && waiting > 0) {
-    for (uint32_t v : frontier) waiting -= v < c.n && c.eligible[v];  // (a reached vertex's component is seeded)
-    rings.push_back(frontier);
-    next_frontier.clear();
-    for (uint32_t v : frontier) queue_neighbours(v, next_frontier);
-    frontier.swap(next_frontier);
-  }
-  // Keep only what the stage's vertices depend on: a ring-r vertex votes from its ring r - 1
-  // neighbours (and the labelled ones), so walking the rings backwards from the stage's vertices
-  // marks every vertex whose label reaches one of them; the others are dropped (same labels, a
-  // fraction of the votes: the matte parts' deep rings are mostly outside the stage's subsample).
-  std::vector<int32_t> ring_of(n, -1);
-  for (size_t r = 0; r < rings.size(); ++r)
-    for (uint32_t v : rings[r]) ring_of[v] = int32_t(r);
-  std::vector<uint8_t> needed(n, 0);
-  for (size_t r = rings.size(); r-- > 0;)
-    for (uint32_t v : rings[r]) {
-      if (!needed[v] && !(v < c.n && c.eligible[v])) continue;
-      needed[v] = 1;
-      if (r == 0) continue;
-      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
-        if (ring_of[adj.neighbours[k]] == int32_t(r) - 1) needed[adj.neighbours[k]] = 1;
-    }
-  for (const std::vector<uint32_t> &ring : rings) {
-    for (uint32_t v : ring)
-      if (needed[v]) R.vertices.push_back(v);
-    R.ring_end.push_back(R.vertices.size());
-  }
-  R.seeded = std::move(seeded);
-  return R;
-}
-
-// The rings for `seeded`, from the context's cache (computed and kept when missing; without a cache
-// into `scratch`).
-const SpreadRings &cached_rings(const Context &c, const Adjacency &adj, std::vector<uint8_t> seeded, SpreadRings &scratch) {
-  if (!c.rings) return scratch = spread_rings(c, adj, std::move(seeded));
-  std::vector<SpreadRings> &kept = c.rings->entries;
-  for (const SpreadRings &r : kept)
-    if (r.seeded == seeded) return r;
-  constexpr size_t kKept = 4;
-  if (kept.size() >= kKept) kept.erase(kept.begin());
-  kept.push_back(spread_rings(c, adj, std::move(seeded)));
-  return kept.back();
-}
-
 // Vertices without a label take the most common label among their labelled neighbours, ring by
 // ring through the mesh (vertices outside the stage pass labels on; spread_rings); an eligible
 // vertex that no label reaches takes its data's best label.
@@ -571,23 +433,9 @@ void spread_labels(const Context &c, const Adjacency &adj, const std::vector<std
   std::vector<uint8_t> seeded(n, 0);
   for (size_t v = 0; v < std::min(n, c.n); ++v) lab[v] = c.eligible[v] ? label[v] : 0, seeded[v] = lab[v] > 0;
   SpreadRings scratch;
-  const SpreadRings &rings = cached_rings(c, adj, std::move(seeded), scratch);
-  // Each ring takes the most common label among its neighbours labelled in earlier rings.
-  std::vector<int> count(size_t(K) + 1);
-  std::vector<int32_t> ring_label;
-  size_t begin = 0;
-  for (size_t end : rings.ring_end) {
-    ring_label.assign(end - begin, 0);
-    for (size_t i = begin; i < end; ++i) {
-      const uint32_t v = rings.vertices[i];
-      std::fill(count.begin(), count.end(), 0);
-      for (uint32_t k = adj.offsets[v]; k < adj.offsets[v + 1]; ++k)
-        if (lab[adj.neighbours[k]] > 0) ++count[size_t(lab[adj.neighbours[k]])];
-      ring_label[i - begin] = int32_t(std::max_element(count.begin() + 1, count.end()) - count.begin());
-    }
-    for (size_t i = begin; i < end; ++i) lab[rings.vertices[i]] = ring_label[i - begin];
-    begin = end;
-  }
+  const SpreadRings &rings = c.rings ? c.rings->rings(adj, std::move(seeded), c.eligible, c.component, c.component_count)
+                                     : (scratch = spread_rings(adj, std::move(seeded), c.eligible, c.component, c.component_count));
+  spread_along_rings(adj, rings, K, lab);
   for (uint32_t v : c.verts) {
     if (v < n && lab[v] > 0) {
       label[v] = lab[v];
@@ -1041,7 +889,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   const Adjacency adj = build_mesh_adjacency(mesh);
   const std::vector<uint32_t> component = connected_components(adj, &c.component_count);
   c.component = &component;
-  RingCache rings_all;
+  SpreadRingCache rings_all;
   std::vector<std::vector<Lobe>> lobes_all;
   c.rings = &rings_all, c.lobe_buffers = &lobes_all;
   std::ostringstream rep;
@@ -1049,7 +897,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   // 1. Choose K and the prior on the training photos, by the error at the held-out ones, on an
   // even subsample of the eligible vertices (selection_subsample).
   Context sel = selection_subsample(c, eligible);
-  RingCache rings_sel;
+  SpreadRingCache rings_sel;
   std::vector<std::vector<Lobe>> lobes_sel;
   sel.rings = &rings_sel, sel.lobe_buffers = &lobes_sel;
   const std::vector<Static> S_train = static_sums(sel, kTrain), S_held = static_sums(sel, kHeld);

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "base/mesh_view.h"
+#include "fit/material_samples.h"
 #include "fit/phong_fit.h"
 #include "samples/samples.h"
 
@@ -113,32 +114,6 @@ struct MaterialResult {
   size_t bytes_kept = 0;
   double seconds = 0;
   std::string report;                  // lines for the fit report
-};
-
-// The fit's usable samples of every vertex, kept while the chunks stream.
-class MaterialSampleStore {
-public:
-  explicit MaterialSampleStore(size_t vertex_count = 0);
-  // Keeps the usable samples of the chunk's vertices; `fits` are the chunk's fits (their status
-  // picks the strict or the weak sample rules). Call once per chunk, before or after the fit.
-  void add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o);
-  struct Entry {
-    float rgb[3];
-    float d, s, w;      // N.L, the lobe's cosine (R.E or N.H), weight (resolution weight included)
-    uint16_t raster;
-    uint16_t flags;     // SampleFlag bits of the sample | its Sample::resolution << 10
-  };
-  size_t vertex_count() const { return begin_.size(); }
-  uint64_t first(size_t v) const { return begin_[v]; }  // index range [first, last) into entries()
-  uint64_t last(size_t v) const { return end_[v]; }
-  const std::vector<Entry> &entries() const { return data_; }
-  size_t bytes() const { return data_.capacity() * sizeof(Entry) + 2 * begin_.capacity() * sizeof(uint64_t); }
-  // Raw samples (for quality metrics) in Sample form, of vertex v.
-  std::vector<Sample> as_samples(size_t v) const;
-
-private:
-  std::vector<uint64_t> begin_, end_;
-  std::vector<Entry> data_;
 };
 
 // Finds the materials, fits their lobes and rewrites the fits of the modelled vertices (see top).
