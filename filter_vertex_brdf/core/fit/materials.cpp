@@ -45,7 +45,7 @@ struct Context {
   uint32_t component_count = 0;
   SpreadRingCache *rings = nullptr;  // spread_labels' rings for this context's vertices (one cache per context)
   // Lobe sums buffers of c.n entries reused by the calls of fit_lobes and assign_labels (never both
-  // at once): lobe_sums then writes only the entries it computes (one pool per context).
+  // at once): lobe_sums_at then writes only the entries it computes (one pool per context).
   std::vector<std::vector<Lobe>> *lobe_buffers = nullptr;
 
   bool in_set(const Entry &e, int set) const {
@@ -106,6 +106,26 @@ std::vector<Static> static_sums(const Context &c, int set) {
 inline void add_to_lobe(Lobe &L, const Entry &e, double g) {
   L.b += double(e.w) * e.d * g, L.g2 += double(e.w) * g * g;
   for (int ch = 0; ch < 3; ++ch) L.q[ch] += double(e.w) * g * e.rgb[ch];
+}
+
+// Lobe sums at many alphas kept as five arrays (b, g2, q_r, q_g, q_b; array j starts at sums +
+// j * stride), so that the loops over the alphas run on contiguous doubles (vectorised).
+// add_to_lobe for sample e at the alphas [first, last] whose lobe values are g[first..last]: the same
+// arithmetic (a zero lobe adds zeros: the same sums).
+inline void add_to_lobes(double *sums, size_t stride, const Entry &e, const double *g, size_t first, size_t last) {
+  double *b = sums, *g2 = sums + stride, *q0 = sums + 2 * stride, *q1 = sums + 3 * stride, *q2 = sums + 4 * stride;
+  const double w = e.w, wd = w * e.d, r0 = e.rgb[0], r1 = e.rgb[1], r2 = e.rgb[2];
+  for (size_t i = first; i <= last; ++i) {
+    const double gi = g[i], wg = w * gi;
+    b[i] += wd * gi, g2[i] += wg * gi, q0[i] += wg * r0, q1[i] += wg * r1, q2[i] += wg * r2;
+  }
+}
+// The Lobe at alpha index i of such arrays.
+inline Lobe lobe_from_sums(const double *sums, size_t stride, size_t i) {
+  Lobe L;
+  L.b = sums[i], L.g2 = sums[stride + i];
+  for (int ch = 0; ch < 3; ++ch) L.q[ch] = sums[(2 + size_t(ch)) * stride + i];
+  return L;
 }
 
 // Pooled k_s from summed k_s equations (num = sum rhs, den = sum info), in [0, ks_max]; 0 without information.
@@ -221,9 +241,8 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
   std::vector<uint32_t> verts;
   for (uint32_t v : c.verts)
     if (label[v] > 0) verts.push_back(v);
-  // Per vertex, the lobe sums at every grid alpha as five arrays of ng (b, g2, q_r, q_g, q_b): the
-  // inner loops over the grid then run on contiguous doubles (vectorised), and a sample's GGX lobe
-  // costs one division per grid point (a^2 per grid point computed once).
+  // Per vertex, the lobe sums at every grid alpha as five arrays of ng (add_to_lobes); a sample's GGX
+  // lobe costs one division per grid point (a^2 per grid point computed once).
   constexpr size_t kSums = 5;
   std::vector<double> sums(verts.size() * kSums * ng, 0.0);
   std::vector<double> a2(ng);
@@ -236,7 +255,7 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
     for (long long t = 0; t < (long long)verts.size(); ++t) {
       const size_t v = verts[size_t(t)];
       const GridWindow r = range_of(size_t(label[v]));
-      double *b = &sums[size_t(t) * kSums * ng], *g2 = b + ng, *q0 = g2 + ng, *q1 = q0 + ng, *q2 = q1 + ng;
+      double *vertex_sums = &sums[size_t(t) * kSums * ng];
       for (uint64_t k = c.store.first(v); k < c.store.last(v); ++k) {
         const Entry &e = entries[k];
         const float ls = (*c.lobe_keys)[k];
@@ -248,21 +267,11 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
           for (size_t i = 0; i <= r.last; ++i)
             g[i] = squared[i] ? square_lobe(g[i - kGridStepsPerDoubling]) : lobe_of(ls, grid[i], false);
         }
-        // add_to_lobe at every grid alpha (a zero lobe adds zeros: the same sums)
-        const double w = e.w, wd = w * e.d, r0 = e.rgb[0], r1 = e.rgb[1], r2 = e.rgb[2];
-        for (size_t i = r.first; i <= r.last; ++i) {
-          const double gi = g[i], wg = w * gi;
-          b[i] += wd * gi, g2[i] += wg * gi, q0[i] += wg * r0, q1[i] += wg * r1, q2[i] += wg * r2;
-        }
+        add_to_lobes(vertex_sums, ng, e, g.data(), r.first, r.last);
       }
     }
   }
-  auto lobe_at = [&](size_t t, size_t i) {
-    const double *b = &sums[t * kSums * ng];
-    Lobe L;
-    L.b = b[i], L.g2 = b[ng + i], L.q[0] = b[2 * ng + i], L.q[1] = b[3 * ng + i], L.q[2] = b[4 * ng + i];
-    return L;
-  };
+  auto lobe_at = [&](size_t t, size_t i) { return lobe_from_sums(&sums[t * kSums * ng], ng, i); };
   E.assign(size_t(K) + 1, std::vector<double>(ng, 0.0));
   KS = E;
   std::vector<std::vector<double>> num = E, den = E;
@@ -638,16 +647,8 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
     }
     const int k_first = centre_only ? kAlphaCentre : 0, k_last = centre_only ? kAlphaCentre : kAlphaSteps - 1;
     double g_of[kAlphaSteps] = {};
-    // Lobe sums at every alpha as five arrays (b, g2, q_r, q_g, q_b) for the fit and the score
-    // samples: contiguous inner loops (vectorised); add_to_lobe's arithmetic, zeros added alike.
-    double fit_sums[5][kAlphaSteps] = {}, score_sums[5][kAlphaSteps] = {};
-    auto accumulate = [&](double (&sums)[5][kAlphaSteps], const Entry &e) {
-      const double w = e.w, wd = w * e.d, r0 = e.rgb[0], r1 = e.rgb[1], r2 = e.rgb[2];
-      for (int k = k_first; k <= k_last; ++k) {
-        const double g = g_of[k], wg = w * g;
-        sums[0][k] += wd * g, sums[1][k] += wg * g, sums[2][k] += wg * r0, sums[3][k] += wg * r1, sums[4][k] += wg * r2;
-      }
-    };
+    // Lobe sums at every alpha of the fit and of the score samples (add_to_lobes).
+    double fit_sums[5 * kAlphaSteps] = {}, score_sums[5 * kAlphaSteps] = {};
     double a2[kAlphaSteps];
     for (int k = 0; k < kAlphaSteps; ++k) a2[k] = lobe[k].a2;
     for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
@@ -664,13 +665,11 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
       } else {
         for (int k = k_first; k <= k_last; ++k) g_of[k] = lobe[k](key);
       }
-      if (f) accumulate(fit_sums, e);
-      if (sc && !same_sets) accumulate(score_sums, e);
+      if (f) add_to_lobes(fit_sums, kAlphaSteps, e, g_of, size_t(k_first), size_t(k_last));
+      if (sc && !same_sets) add_to_lobes(score_sums, kAlphaSteps, e, g_of, size_t(k_first), size_t(k_last));
     }
-    for (int k = k_first; k <= k_last; ++k) {
-      Lf[k].b = fit_sums[0][k], Lf[k].g2 = fit_sums[1][k], Ls[k].b = score_sums[0][k], Ls[k].g2 = score_sums[1][k];
-      for (int ch = 0; ch < 3; ++ch) Lf[k].q[ch] = fit_sums[2 + ch][k], Ls[k].q[ch] = score_sums[2 + ch][k];
-    }
+    for (int k = k_first; k <= k_last; ++k)
+      Lf[k] = lobe_from_sums(fit_sums, kAlphaSteps, size_t(k)), Ls[k] = lobe_from_sums(score_sums, kAlphaSteps, size_t(k));
     for (size_t ch = 0; ch < nc; ++ch) {
       const double lambda = choices[ch].prior * mean_info[m];
       const double mu = choices[ch].alpha_prior * mean_info[m] * lobes[m].ks * lobes[m].ks;
@@ -792,14 +791,31 @@ bool keeps_own_fit(const MaterialOptions &mo, bool diffuse_material, const Verte
 // errors over step 1's subsample, the lobes refitted on the training photos of the final labels.
 struct GivingTest {
   double with_lobe = 0, without_lobe = 0;
-  size_t vertices = 0;     // subsample vertices without a lobe of their own
-  double min_gain = 0;     // MaterialOptions::min_giving_gain
-  bool gives() const { return vertices == 0 || with_lobe < (1 - min_gain) * without_lobe; }
+  size_t vertices = 0;  // subsample vertices without a lobe of their own
+  // Given when it lowers their held-out error by at least min_gain (MaterialOptions::min_giving_gain).
+  bool gives(double min_gain) const { return vertices == 0 || with_lobe < (1 - min_gain) * without_lobe; }
 };
 
 std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static> &S_train, const std::vector<Static> &S_held,
                                     const std::vector<int32_t> &label, const std::vector<uint8_t> &diffuse, int K,
-                                    const Choice &choice, const std::vector<VertexFit> &fits);
+                                    const Choice &choice, const std::vector<VertexFit> &fits) {
+  std::vector<int32_t> sel_label(sel.n, 0);
+  for (uint32_t v : sel.verts) sel_label[v] = label[v];
+  const std::vector<LobeFit> train_lobes = fit_lobes(sel, kTrain, S_train, sel_label, K);
+  std::vector<double> error;
+  solve_vertices(sel, S_train, S_held, kTrain, kHeld, sel_label, train_lobes, diffuse, K, {choice}, nullptr, nullptr, &error);
+  std::vector<GivingTest> out(size_t(K) + 1);
+  for (size_t t = 0; t < sel.verts.size(); ++t) {
+    const uint32_t v = sel.verts[t];
+    const int32_t m = sel_label[v];
+    if (m <= 0 || diffuse[size_t(m)] || keeps_own_fit(sel.mo, false, fits[v])) continue;
+    double rho[3];
+    energy_ks(S_train[v], Lobe(), 0, rho);
+    GivingTest &g = out[size_t(m)];
+    g.with_lobe += error[t], g.without_lobe += energy_fixed(S_held[v], Lobe(), 0, rho), ++g.vertices;
+  }
+  return out;
+}
 
 struct Config {
   int K = 0;
@@ -828,28 +844,6 @@ Config cluster(const Context &c, const Adjacency &adj, const std::vector<Static>
   if (exact_ranges && windowed) lobes = fit_lobes(c, set, S, label, K);
   cfg.K = K, cfg.label = std::move(label), cfg.lobes = std::move(lobes);
   return cfg;
-}
-
-std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static> &S_train, const std::vector<Static> &S_held,
-                                    const std::vector<int32_t> &label, const std::vector<uint8_t> &diffuse, int K,
-                                    const Choice &choice, const std::vector<VertexFit> &fits) {
-  std::vector<int32_t> sel_label(sel.n, 0);
-  for (uint32_t v : sel.verts) sel_label[v] = label[v];
-  const std::vector<LobeFit> train_lobes = fit_lobes(sel, kTrain, S_train, sel_label, K);
-  std::vector<double> error;
-  solve_vertices(sel, S_train, S_held, kTrain, kHeld, sel_label, train_lobes, diffuse, K, {choice}, nullptr, nullptr, &error);
-  std::vector<GivingTest> out(size_t(K) + 1);
-  for (GivingTest &g : out) g.min_gain = sel.mo.min_giving_gain;
-  for (size_t t = 0; t < sel.verts.size(); ++t) {
-    const uint32_t v = sel.verts[t];
-    const int32_t m = sel_label[v];
-    if (m <= 0 || diffuse[size_t(m)] || keeps_own_fit(sel.mo, false, fits[v])) continue;
-    double rho[3];
-    energy_ks(S_train[v], Lobe(), 0, rho);
-    GivingTest &g = out[size_t(m)];
-    g.with_lobe += error[t], g.without_lobe += energy_fixed(S_held[v], Lobe(), 0, rho), ++g.vertices;
-  }
-  return out;
 }
 
 std::string fixed(double v, int digits) {
@@ -983,7 +977,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   for (uint32_t v : c.verts) {
     const size_t m = size_t(std::max(0, fin.label[v]));
     rewritten[v] = any_glossy && m > 0 && !keeps_own_fit(mo, diffuse[m] != 0, fits[v]) &&
-                   (diffuse[m] ? fits[v].ks > 0 : giving[m].gives());
+                   (diffuse[m] ? fits[v].ks > 0 : giving[m].gives(mo.min_giving_gain));
   }
   solve_vertices(c, S, S, kAll, kAll, fin.label, fin.lobes, diffuse, K, {best_choice[chosen]}, &P, &rewritten);
 
@@ -1005,12 +999,11 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : to_specular, to_diffuse) if (c.n > 20000)
   for (long long vi = 0; vi < (long long)c.n; ++vi) {
     const size_t v = size_t(vi);
-    if (!c.eligible[v] || fin.label[v] <= 0) continue;
+    if (!rewritten[v]) continue;  // (a rewritten vertex is eligible and labelled)
     const size_t m = size_t(fin.label[v]);
     VertexFit &f = fits[v];
     const bool had_ks = f.ks > 0;
     const bool weak = f.status == kFitFromWeakSamples;
-    if (!rewritten[v]) continue;
     const std::vector<Sample> samples = store.as_samples(v);
     if (diffuse[m] && diffuse_rgb && diffuse_valid && diffuse_valid[v] && !weak) {
       set_diffuse_only_reflectance(samples.data(), samples.size(), o, diffuse_rgb + 3 * v, f);
@@ -1053,11 +1046,15 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
           << ", or the lobe lowers the energy by less than " << fixed(100 * mo.min_lobe_gain, 1)
           << " %)" << (any_glossy ? ": k_s = 0, specular stages skipped for its vertices" : "");
     const GivingTest &g = giving[size_t(m)];
-    if (!mat.diffuse && g.vertices)
+    if (!mat.diffuse && g.vertices) {
       rep << "; its lobe given to the vertices without one of their own? held-out error on " << g.vertices
           << " such vertices of the subsample " << fixed(g.with_lobe, 4) << " with it, " << fixed(g.without_lobe, 4)
-          << " without: " << (g.gives() ? "given" : "NOT given (less than ")
-          << (g.gives() ? "" : fixed(100 * g.min_gain, 1) + " % lower: they keep their own fit)");
+          << " without: ";
+      if (g.gives(mo.min_giving_gain))
+        rep << "given";
+      else
+        rep << "NOT given (less than " << fixed(100 * mo.min_giving_gain, 1) << " % lower: they keep their own fit)";
+    }
     rep << "\n";
   }
   if (!any_glossy)
