@@ -239,6 +239,44 @@ TEST(Materials, LobesAreGivenOnlyWhereTheHeldOutPhotosSayTheyHelp) {
   }
 }
 
+// The scene with one more sample per vertex in each held-out photo of the giving test (raster % 4 ==
+// 3): grazing light (N.L = 0.05, flagged kGrazing: the fits leave it out) at a lobe cosine where the
+// lobe is bright, and the photo dark there (the diffuse term only, as a microfacet lobe's shadowing
+// makes it): the pixels a relit lobe would light wrongly.
+Scene with_dark_grazing_samples(const Scene &sc) {
+  Scene out = sc;
+  out.chunk.samples.clear();
+  out.chunk.offsets.assign(1, 0);
+  for (uint32_t v = 0; v < sc.chunk.vertex_count; ++v) {
+    for (uint32_t k = sc.chunk.offsets[v]; k < sc.chunk.offsets[v + 1]; ++k) {
+      const Sample &smp = sc.chunk.samples[k];
+      out.chunk.samples.push_back(smp);
+      if (smp.raster % 4 != 3) continue;
+      Sample dark = smp;  // the held-out photo's colour at N.L = 0.05, without the lobe
+      const float scale = smp.d > 0.05f ? 0.05f / smp.d : 1.0f;
+      for (float &c : dark.rgb) c *= scale;
+      dark.d = 0.05f, dark.lobe_cos = 0.99f, dark.flags = kGrazing;
+      out.chunk.samples.push_back(dark);
+    }
+    out.chunk.offsets.push_back(uint32_t(out.chunk.samples.size()));
+  }
+  return out;
+}
+
+// The giving test scores the grazing-light samples too (which the fits leave out): a lobe that would
+// light them where the photos stay dark is not given; without them the same lobe is.
+TEST(Materials, ALobeThatLightsDarkGrazingSamplesIsNotGiven) {
+  const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
+  const StageRun plain = run_stage(sc);
+  ASSERT_GT(plain.result.vertices_changed_to_specular, 0u) << plain.result.report;
+  const StageRun dark = run_stage(with_dark_grazing_samples(sc));
+  ASSERT_EQ(dark.result.chosen_k, 2) << dark.result.report;
+  EXPECT_EQ(dark.result.vertices_changed_to_specular, 0u) << dark.result.report;
+  EXPECT_NE(dark.result.report.find("NOT given"), std::string::npos) << dark.result.report;
+  for (size_t v = 0; v < sc.truth.size(); ++v)  // the fits never saw the added samples
+    ASSERT_EQ(dark.before[v].ks, plain.before[v].ks) << "vertex " << v;
+}
+
 TEST(Materials, ByDefaultOwnLobesAreKeptAndTheOthersGetTheMaterials) {
   const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
   const StageRun r = run_stage(sc);

@@ -5,7 +5,8 @@
 
 namespace vbrdf {
 
-MaterialSampleStore::MaterialSampleStore(size_t vertex_count) : begin_(vertex_count, 0), end_(vertex_count, 0) {}
+MaterialSampleStore::MaterialSampleStore(size_t vertex_count)
+    : begin_(vertex_count, 0), end_(vertex_count, 0), grazing_begin_(vertex_count, 0), grazing_end_(vertex_count, 0) {}
 
 namespace {
 // The fit's usable-sample rules (phong_fit_cpu.cpp usable_samples), strict or weak.
@@ -16,30 +17,44 @@ bool kept_sample(const Sample &s, bool weak) {
   return std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]) && std::isfinite(s.lobe_cos) &&
          std::isfinite(s.d);
 }
+// A lit sample the strict rules leave out only as grazing (N.L < T_d without a highlight).
+bool grazing_sample(const Sample &s) {
+  return (s.flags & kGrazing) && !(s.flags & (kHighlight | kShadowed | kSaturated | kNotSeen | kMixedPixel)) && s.d > 0 &&
+         std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]) && std::isfinite(s.lobe_cos);
+}
+MaterialSampleStore::Entry entry_of(const Sample &s, float w) {
+  return {{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.d, 1.0f), s.lobe_cos, w, s.raster, uint16_t(s.flags | s.resolution << 10)};
+}
 } // namespace
 
 void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o) {
   // Counted first, so that the store grows once per chunk (geometrically) rather than by doubling
   // copies of tens of MB as entries are pushed.
   const uint32_t count = std::min<uint64_t>(chunk.vertex_count, begin_.size() - std::min<uint64_t>(begin_.size(), chunk.first_vertex));
-  size_t kept = 0;
+  size_t kept = 0, grazing = 0;
   for (uint32_t i = 0; i < count; ++i) {
     const bool weak = fits[i].status == kFitFromWeakSamples;
-    for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) kept += kept_sample(chunk.samples[k], weak);
+    for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
+      const bool keep = kept_sample(chunk.samples[k], weak);
+      kept += keep, grazing += !keep && grazing_sample(chunk.samples[k]);
+    }
   }
-  if (data_.size() + kept > data_.capacity()) data_.reserve(std::max(data_.size() + kept, data_.capacity() + data_.capacity() / 2));
+  auto grow = [](std::vector<Entry> &d, size_t more) {
+    if (d.size() + more > d.capacity()) d.reserve(std::max(d.size() + more, d.capacity() + d.capacity() / 2));
+  };
+  grow(data_, kept), grow(grazing_, grazing);
   for (uint32_t i = 0; i < count; ++i) {
     const size_t v = size_t(chunk.first_vertex) + i;
     const bool weak = fits[i].status == kFitFromWeakSamples;
-    begin_[v] = data_.size();
+    begin_[v] = data_.size(), grazing_begin_[v] = grazing_.size();
     for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
       const Sample &s = chunk.samples[k];
-      if (!kept_sample(s, weak)) continue;
-      const float w = s.d * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f);
-      data_.push_back({{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.d, 1.0f), s.lobe_cos, w, s.raster,
-                       uint16_t(s.flags | s.resolution << 10)});
+      if (kept_sample(s, weak))
+        data_.push_back(entry_of(s, s.d * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f)));
+      else if (grazing_sample(s))
+        grazing_.push_back(entry_of(s, s.d * resolution_weight(s)));
     }
-    end_[v] = data_.size();
+    end_[v] = data_.size(), grazing_end_[v] = grazing_.size();
   }
 }
 

@@ -1,5 +1,6 @@
 #include "fit/materials.h"
 
+#include "base/color_difference.h"
 #include "base/mesh_adjacency.h"
 #include "fit/label_spread.h"
 
@@ -787,32 +788,69 @@ bool keeps_own_fit(const MaterialOptions &mo, bool diffuse_material, const Verte
 }
 
 // Whether a glossy material's lobe predicts the held-out photos of its vertices that have no lobe of
-// their own better than no lobe does (the per-vertex fit's diffuse-only answer): summed held-out
-// errors over step 1's subsample, the lobes refitted on the training photos of the final labels.
+// their own better than no lobe does (the per-vertex fit's diffuse-only answer), in CIEDE2000 per
+// held-out sample (clean and grazing) over step 1's subsample, the lobes refitted on the training
+// photos of the final labels (MaterialOptions::min_giving_gain, giving_confidence).
 struct GivingTest {
-  double with_lobe = 0, without_lobe = 0;
-  size_t vertices = 0;  // subsample vertices without a lobe of their own
-  // Given when it lowers their held-out error by at least min_gain (MaterialOptions::min_giving_gain).
-  bool gives(double min_gain) const { return vertices == 0 || with_lobe < (1 - min_gain) * without_lobe; }
+  double with_lobe = 0, without_lobe = 0;  // summed CIEDE2000 over the held-out samples
+  double diff_sum = 0, diff_sq = 0;        // per vertex: its summed CIEDE2000 with minus without
+  size_t vertices = 0;                     // subsample vertices without a lobe of their own
+  size_t samples = 0;
+  double mean_with() const { return samples ? with_lobe / double(samples) : 0; }
+  double mean_without() const { return samples ? without_lobe / double(samples) : 0; }
+  // Standard error of the mean per-vertex difference (0 for fewer than two vertices).
+  double standard_error() const {
+    if (vertices < 2) return 0;
+    const double n = double(vertices), mean = diff_sum / n;
+    return std::sqrt(std::max(0.0, diff_sq / n - mean * mean) / (n - 1));
+  }
+  bool gives(const MaterialOptions &mo) const {
+    if (vertices == 0) return true;
+    if (vertices < 2) return false;
+    return with_lobe < (1 - double(mo.min_giving_gain)) * without_lobe &&
+           diff_sum / double(vertices) + double(mo.giving_confidence) * standard_error() < 0;
+  }
 };
 
-std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static> &S_train, const std::vector<Static> &S_held,
-                                    const std::vector<int32_t> &label, const std::vector<uint8_t> &diffuse, int K,
-                                    const Choice &choice, const std::vector<VertexFit> &fits) {
+std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static> &S_train, const std::vector<int32_t> &label,
+                                    const std::vector<uint8_t> &diffuse, int K, const Choice &choice,
+                                    const std::vector<VertexFit> &fits) {
   std::vector<int32_t> sel_label(sel.n, 0);
   for (uint32_t v : sel.verts) sel_label[v] = label[v];
   const std::vector<LobeFit> train_lobes = fit_lobes(sel, kTrain, S_train, sel_label, K);
-  std::vector<double> error;
-  solve_vertices(sel, S_train, S_held, kTrain, kHeld, sel_label, train_lobes, diffuse, K, {choice}, nullptr, nullptr, &error);
-  std::vector<GivingTest> out(size_t(K) + 1);
-  for (size_t t = 0; t < sel.verts.size(); ++t) {
-    const uint32_t v = sel.verts[t];
+  std::vector<uint8_t> tested(sel.n, 0);
+  for (uint32_t v : sel.verts) {
     const int32_t m = sel_label[v];
-    if (m <= 0 || diffuse[size_t(m)] || keeps_own_fit(sel.mo, false, fits[v])) continue;
-    double rho[3];
+    tested[v] = m > 0 && !diffuse[size_t(m)] && !keeps_own_fit(sel.mo, false, fits[v]);
+  }
+  Params P;  // with the lobe (the chosen priors), fitted on the training photos
+  solve_vertices(sel, S_train, S_train, kTrain, kTrain, sel_label, train_lobes, diffuse, K, {choice}, &P, &tested);
+  std::vector<GivingTest> out(size_t(K) + 1);
+  const MaterialSampleStore &store = sel.store;
+  for (uint32_t v : sel.verts) {
+    if (!tested[v]) continue;
+    double rho[3];  // without a lobe: the diffuse-only least squares on the training photos
     energy_ks(S_train[v], Lobe(), 0, rho);
-    GivingTest &g = out[size_t(m)];
-    g.with_lobe += error[t], g.without_lobe += energy_fixed(S_held[v], Lobe(), 0, rho), ++g.vertices;
+    const LobeAt lobe(P.alpha[v], sel.ggx);
+    GivingTest &g = out[size_t(sel_label[v])];
+    double with_sum = 0, without_sum = 0;
+    auto score = [&](const Entry &e, float key) {
+      if (!sel.in_set(e, kHeld)) return;
+      const double gk = lobe(key);
+      float with[3], without[3];
+      for (int ch = 0; ch < 3; ++ch) {
+        with[ch] = float(P.rho[3 * v + size_t(ch)] * e.d + P.ks[v] * gk);
+        without[ch] = float(rho[ch] * e.d);
+      }
+      with_sum += delta_e2000_linear_srgb(with, e.rgb), without_sum += delta_e2000_linear_srgb(without, e.rgb);
+      ++g.samples;
+    };
+    for (uint64_t k = store.first(v); k < store.last(v); ++k) score(store.entries()[k], (*sel.lobe_keys)[k]);
+    for (uint64_t k = store.grazing_first(v); k < store.grazing_last(v); ++k)
+      score(store.grazing_entries()[k], lobe_key(store.grazing_entries()[k].s, sel.ggx));
+    g.with_lobe += with_sum, g.without_lobe += without_sum;
+    g.diff_sum += with_sum - without_sum, g.diff_sq += (with_sum - without_sum) * (with_sum - without_sum);
+    ++g.vertices;
   }
   return out;
 }
@@ -969,7 +1007,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   // misfit: every vertex keeps its own fit (stripping those lobes raises horse's mean / p95 from
   // 2.88 / 6.02 to 2.93 / 6.40 at its held-out lights; ctest psm_real_materials).
   const bool any_glossy = std::count(diffuse.begin() + 1, diffuse.end(), uint8_t(0)) > 0;
-  const std::vector<GivingTest> giving = any_glossy ? test_giving(sel, S_train, S_held, fin.label, diffuse, K, best_choice[chosen], fits)
+  const std::vector<GivingTest> giving = any_glossy ? test_giving(sel, S_train, fin.label, diffuse, K, best_choice[chosen], fits)
                                                     : std::vector<GivingTest>(size_t(K) + 1);
   // Vertices that keep their own fit (step 3) need no parameters: on the benchmark scene 38 k of
   // its 54 k, most of this solve's time.
@@ -977,7 +1015,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   for (uint32_t v : c.verts) {
     const size_t m = size_t(std::max(0, fin.label[v]));
     rewritten[v] = any_glossy && m > 0 && !keeps_own_fit(mo, diffuse[m] != 0, fits[v]) &&
-                   (diffuse[m] ? fits[v].ks > 0 : giving[m].gives(mo.min_giving_gain));
+                   (diffuse[m] ? fits[v].ks > 0 : giving[m].gives(mo));
   }
   solve_vertices(c, S, S, kAll, kAll, fin.label, fin.lobes, diffuse, K, {best_choice[chosen]}, &P, &rewritten);
 
@@ -1047,13 +1085,15 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
           << " %)" << (any_glossy ? ": k_s = 0, specular stages skipped for its vertices" : "");
     const GivingTest &g = giving[size_t(m)];
     if (!mat.diffuse && g.vertices) {
-      rep << "; its lobe given to the vertices without one of their own? held-out error on " << g.vertices
-          << " such vertices of the subsample " << fixed(g.with_lobe, 4) << " with it, " << fixed(g.without_lobe, 4)
-          << " without: ";
-      if (g.gives(mo.min_giving_gain))
+      rep << "; its lobe given to the vertices without one of their own? on " << g.vertices << " such vertices of the subsample, "
+          << g.samples << " held-out samples (grazing ones included): mean CIEDE2000 " << fixed(g.mean_with(), 3)
+          << " with it, " << fixed(g.mean_without(), 3) << " without (per vertex " << fixed(g.diff_sum / double(g.vertices), 3)
+          << " +- " << fixed(g.standard_error(), 3) << "): ";
+      if (g.gives(mo))
         rep << "given";
       else
-        rep << "NOT given (less than " << fixed(100 * mo.min_giving_gain, 1) << " % lower: they keep their own fit)";
+        rep << "NOT given (not " << fixed(100 * mo.min_giving_gain, 1) << " % lower by " << fixed(mo.giving_confidence, 1)
+            << " standard errors: they keep their own fit)";
     }
     rep << "\n";
   }
