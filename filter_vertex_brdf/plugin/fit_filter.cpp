@@ -116,8 +116,9 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "specular response (how many: chosen by the error at held-out photos), fit one "
                            "lobe per material from the samples of all its vertices and give every vertex of a "
                            "glossy material a specular term (a vertex sees one or two highlights, a material "
-                           "many); a diffuse material gets none. Writes per-vertex 'material'; the report lists "
-                           "the materials. Holds better from other cameras; costs about a quarter more time."));
+                           "many; given only where the held-out photos show it helps); a diffuse material gets "
+                           "none. Writes per-vertex 'material'; the report lists the materials. Holds better "
+                           "from other cameras; costs about a seventh more time. On by default."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));

@@ -77,9 +77,10 @@ struct FitSettings {
   // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.
   int fill_unseen_rings = 0;
   // Material stage (materials.h, issue 16): materials found from the data, a lobe per material
-  // from the pooled samples, every vertex of a glossy material with a specular term. CPU, after
-  // either fit back end. Keeps the usable samples in memory (28 bytes each) until the stage ran.
-  bool materials = false;
+  // from the pooled samples, every vertex of a glossy material with a specular term where the
+  // held-out photos show it helps. CPU, after either fit back end. Keeps the usable (and grazing)
+  // samples in memory (28 bytes each) until the stage ran. On by default since 2026-12-04.
+  bool materials = true;
   MaterialOptions material_options;
   // Samples far darker than their vertex's model although the mesh lets the light reach them
   // (photo_shadows.h): left out, the vertex refitted. On by default; off for comparisons.
