@@ -140,7 +140,7 @@ TEST(WeakFit, GrazingOrMixedOnlyVerticesStillGetAModel) {
   EXPECT_EQ(weak.kd, 0.0f);
 }
 
-// The material stage stops spreading labels where no labelled vertex can reach (materials.cpp):
+// The material stage stops spreading labels where no labelled vertex can reach (material_labels.cpp):
 // it needs each vertex's connected component.
 TEST(MeshAdjacency, ConnectedComponentsNumberedByTheirLowestVertex) {
   MeshData mesh;

@@ -1,5 +1,5 @@
 #pragma once
-// Labels spread over a mesh ring by ring (the material stage's, materials.cpp): ring 0 is the
+// Labels spread over a mesh ring by ring (the material stage's, material_labels.cpp): ring 0 is the
 // unlabelled neighbours of the labelled vertices, ring r + 1 the unlabelled, not yet reached
 // neighbours of ring r, and each ring takes the most common label among its neighbours labelled in
 // earlier rings. The rings depend on which vertices are labelled, not on their labels, so a caller
