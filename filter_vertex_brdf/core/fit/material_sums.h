@@ -2,6 +2,8 @@
 // The material stage's shared vocabulary (materials.h; internal to core/fit/material_*.cpp and
 // materials.cpp): the context the stage runs in, the per-vertex sums of its samples that the pooled
 // lobe fits, the labelling and the per-vertex solves share, and the closed forms on those sums.
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -140,6 +142,7 @@ inline void ks_equation(const Static &S, const Lobe &L, double &info, double &rh
   for (int ch = 0; ch < 3; ++ch) rhs += L.q[ch] - L.b * S.p[ch] * inv_a;
 }
 
+// Energy (the weighted sum of squared residuals) of k_s and rho fixed, from the sums; >= 0.
 inline double energy_fixed(const Static &S, const Lobe &L, double ks, const double rho[3]) {
   double e = 0;
   for (int ch = 0; ch < 3; ++ch)
