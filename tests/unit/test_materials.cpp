@@ -9,6 +9,10 @@
 #include <random>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "fit/materials.h"
 #include "test_scenes.h"
 
@@ -167,6 +171,31 @@ TEST(Materials, ChosenOnASubsampleOfALargeMesh) {
   for (int32_t label : r.result.label) unlabelled += label <= 0 || label > 2;
   EXPECT_EQ(unlabelled, 0u);
   expect_two_materials_found(sc, r, ks, alpha);
+}
+
+// The stage's loops (and the K of its choice, clustered concurrently) sum per vertex or in a fixed
+// order: one thread and several give the same labels, lobes and fits, bit for bit.
+TEST(Materials, TheSameResultsOnOneThreadAndOnSeveral) {
+#ifdef _OPENMP
+  const Scene sc = make_scene(true, 0.5f, 120.0f, 11, LobeForm::GgxNH, 120);  // subsampled choice, parallel loops
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const StageRun one = run_stage(sc, MaterialOptions(), LobeForm::GgxNH);
+  omp_set_num_threads(std::max(2, threads));
+  const StageRun several = run_stage(sc, MaterialOptions(), LobeForm::GgxNH);
+  omp_set_num_threads(threads);
+  ASSERT_EQ(one.result.chosen_k, several.result.chosen_k);
+  EXPECT_EQ(one.result.label, several.result.label);
+  EXPECT_EQ(one.result.heldout_error, several.result.heldout_error);
+  for (size_t v = 0; v < sc.truth.size(); ++v) {
+    ASSERT_EQ(one.after[v].kd, several.after[v].kd) << "vertex " << v;
+    ASSERT_EQ(one.after[v].ks, several.after[v].ks) << "vertex " << v;
+    ASSERT_EQ(one.after[v].shininess, several.after[v].shininess) << "vertex " << v;
+    for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(one.after[v].color[ch], several.after[v].color[ch]) << "vertex " << v;
+  }
+#else
+  GTEST_SKIP() << "built without OpenMP: one thread only";
+#endif
 }
 
 INSTANTIATE_TEST_SUITE_P(LobeForms, MaterialsBothLobes,
