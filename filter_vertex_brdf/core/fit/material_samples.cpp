@@ -31,12 +31,15 @@ void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *f
   // Counted first, so that the store grows once per chunk (geometrically) rather than by doubling
   // copies of tens of MB as entries are pushed.
   const uint32_t count = std::min<uint64_t>(chunk.vertex_count, begin_.size() - std::min<uint64_t>(begin_.size(), chunk.first_vertex));
+  // Each sample's fate is decided once: 0 dropped, 1 kept, 2 kept apart as grazing.
+  std::vector<uint8_t> fate(count ? chunk.offsets[count] : 0, 0);
   size_t kept = 0, grazing = 0;
   for (uint32_t i = 0; i < count; ++i) {
     const bool weak = fits[i].status == kFitFromWeakSamples;
     for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
-      const bool keep = kept_sample(chunk.samples[k], weak);
-      kept += keep, grazing += !keep && grazing_sample(chunk.samples[k]);
+      const Sample &s = chunk.samples[k];
+      fate[k] = kept_sample(s, weak) ? 1 : grazing_sample(s) ? 2 : 0;
+      kept += fate[k] == 1, grazing += fate[k] == 2;
     }
   }
   auto grow = [](std::vector<Entry> &d, size_t more) {
@@ -45,13 +48,12 @@ void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *f
   grow(data_, kept), grow(grazing_, grazing);
   for (uint32_t i = 0; i < count; ++i) {
     const size_t v = size_t(chunk.first_vertex) + i;
-    const bool weak = fits[i].status == kFitFromWeakSamples;
     begin_[v] = data_.size(), grazing_begin_[v] = grazing_.size();
     for (uint32_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k) {
       const Sample &s = chunk.samples[k];
-      if (kept_sample(s, weak))
+      if (fate[k] == 1)
         data_.push_back(entry_of(s, s.d * resolution_weight(s) * ((s.flags & kMixedPixel) ? o.mixed_sample_weight : 1.0f)));
-      else if (grazing_sample(s))
+      else if (fate[k] == 2)
         grazing_.push_back(entry_of(s, s.d * resolution_weight(s)));
     }
     end_[v] = data_.size(), grazing_end_[v] = grazing_.size();

@@ -13,8 +13,7 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
                                    int fit_set, int score_set, const std::vector<int32_t> &label,
                                    const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse, int K,
                                    const std::vector<Choice> &choices, Params *params,
-                                   const std::vector<uint8_t> *wanted,
-                                   std::vector<double> *vertex_error) {
+                                   const std::vector<uint8_t> *wanted) {
   // The material's mean k_s information at its alpha: the scale of both priors.
   std::vector<double> alpha_of(size_t(K) + 1, 1.0);
   for (int m = 1; m <= K; ++m) alpha_of[size_t(m)] = lobes[size_t(m)].alpha;
@@ -126,10 +125,6 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
       }
     }
   }
-  if (vertex_error) {
-    vertex_error->assign(c.verts.size(), 0.0);
-    for (size_t t = 0; t < c.verts.size(); ++t) (*vertex_error)[t] = score[t * nc];
-  }
   std::vector<double> total(nc, 0.0);
   for (size_t t = 0; t < c.verts.size(); ++t)
     if (S_fit[c.verts[t]].n > 0)
@@ -197,16 +192,14 @@ bool keeps_own_fit(const MaterialOptions &mo, bool diffuse_material, const Verte
 std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static> &S_train, const std::vector<int32_t> &label,
                                     const std::vector<uint8_t> &diffuse, int K, const Choice &choice,
                                     const std::vector<VertexFit> &fits) {
-  std::vector<int32_t> sel_label(sel.n, 0);
-  for (uint32_t v : sel.verts) sel_label[v] = label[v];
-  const std::vector<LobeFit> train_lobes = fit_lobes(sel, kTrain, S_train, sel_label, K);
+  const std::vector<LobeFit> train_lobes = fit_lobes(sel, kTrain, S_train, label, K);
   std::vector<uint8_t> tested(sel.n, 0);
   for (uint32_t v : sel.verts) {
-    const int32_t m = sel_label[v];
+    const int32_t m = label[v];
     tested[v] = m > 0 && !diffuse[size_t(m)] && !keeps_own_fit(sel.mo, false, fits[v]);
   }
   Params P;  // with the lobe (the chosen priors), fitted on the training photos
-  solve_vertices(sel, S_train, S_train, kTrain, kTrain, sel_label, train_lobes, diffuse, K, {choice}, &P, &tested);
+  solve_vertices(sel, S_train, S_train, kTrain, kTrain, label, train_lobes, diffuse, K, {choice}, &P, &tested);
   std::vector<GivingTest> out(size_t(K) + 1);
   const MaterialSampleStore &store = sel.store;
   for (uint32_t v : sel.verts) {
@@ -214,7 +207,7 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     double rho[3];  // without a lobe: the diffuse-only least squares on the training photos
     energy_ks(S_train[v], Lobe(), 0, rho);
     const LobeAt lobe(P.alpha[v], sel.ggx);
-    GivingTest &g = out[size_t(sel_label[v])];
+    GivingTest &g = out[size_t(label[v])];
     double with_sum = 0, without_sum = 0;
     auto score = [&](const Entry &e, float key) {
       if (!sel.in_set(e, kHeld)) return;
@@ -231,7 +224,7 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     for (uint64_t k = store.grazing_first(v); k < store.grazing_last(v); ++k)
       score(store.grazing_entries()[k], lobe_key(store.grazing_entries()[k].s, sel.ggx));
     g.with_lobe += with_sum, g.without_lobe += without_sum;
-    g.diff_sum += with_sum - without_sum, g.diff_sq += (with_sum - without_sum) * (with_sum - without_sum);
+    g.diff_sq += (with_sum - without_sum) * (with_sum - without_sum);
     ++g.vertices;
   }
   return out;

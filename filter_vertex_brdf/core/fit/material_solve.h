@@ -30,14 +30,12 @@ struct Params {
 // For every choice, the error of its parameters (fitted on `fit_set`) at `score_set` (summed over
 // the vertices), and, when `params` is given, the parameters of choice 0. `wanted` (may be null):
 // per vertex, 0 = its parameters are not needed (skipped: its params and score stay 0; the priors'
-// scale is still taken over every labelled vertex). `vertex_error` (may be null): choice 0's error
-// of every vertex, by position in c.verts.
+// scale is still taken over every labelled vertex).
 std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &S_fit, const std::vector<Static> &S_score,
                                    int fit_set, int score_set, const std::vector<int32_t> &label,
                                    const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse, int K,
                                    const std::vector<Choice> &choices, Params *params,
-                                   const std::vector<uint8_t> *wanted = nullptr,
-                                   std::vector<double> *vertex_error = nullptr);
+                                   const std::vector<uint8_t> *wanted = nullptr);
 
 // Per material 1..K: 1 when it is diffuse (its pooled lobe's k_s below diffuse_ks_fraction of its
 // median k_d, its alpha at or below min_lobe_alpha (4x for the N.H forms), or its energy gain below
@@ -62,22 +60,23 @@ bool keeps_own_fit(const MaterialOptions &mo, bool diffuse_material, const Verte
 // photos of the final labels (MaterialOptions::min_giving_gain, giving_confidence).
 struct GivingTest {
   double with_lobe = 0, without_lobe = 0;  // summed CIEDE2000 over the held-out samples
-  double diff_sum = 0, diff_sq = 0;        // per vertex: its summed CIEDE2000 with minus without
+  double diff_sq = 0;  // sum over the vertices of (their summed CIEDE2000 with minus without)^2
   size_t vertices = 0;                     // subsample vertices without a lobe of their own
   size_t samples = 0;
   double mean_with() const { return samples ? with_lobe / double(samples) : 0; }
   double mean_without() const { return samples ? without_lobe / double(samples) : 0; }
-  // Standard error of the mean per-vertex difference (0 for fewer than two vertices).
+  // Mean per-vertex difference (with minus without) and its standard error (0 for fewer than two vertices).
+  double mean_difference() const { return vertices ? (with_lobe - without_lobe) / double(vertices) : 0; }
   double standard_error() const {
     if (vertices < 2) return 0;
-    const double n = double(vertices), mean = diff_sum / n;
+    const double n = double(vertices), mean = mean_difference();
     return std::sqrt(std::max(0.0, diff_sq / n - mean * mean) / (n - 1));
   }
   bool gives(const MaterialOptions &mo) const {
     if (vertices == 0) return true;
     if (vertices < 2) return false;
     return with_lobe < (1 - double(mo.min_giving_gain)) * without_lobe &&
-           diff_sum / double(vertices) + double(mo.giving_confidence) * standard_error() < 0;
+           mean_difference() + double(mo.giving_confidence) * standard_error() < 0;
   }
 };
 std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static> &S_train, const std::vector<int32_t> &label,

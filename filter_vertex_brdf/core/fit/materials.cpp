@@ -23,7 +23,6 @@ namespace {
 // On the benchmark's 100 k vertices (45 k eligible) the choice took 1.68 s on all of them, 0.24 s
 // on 3000 (same K and lobes: README "The material stage's cost").
 constexpr size_t kSelectionVertices = 3000;
-size_t count_eligible(const Context &c) { return size_t(std::count(c.eligible.begin(), c.eligible.end(), uint8_t(1))); }
 Context selection_subsample(const Context &c, size_t eligible) {
   Context sel = c;
   const size_t stride = (eligible + kSelectionVertices - 1) / kSelectionVertices;
@@ -259,7 +258,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     if (!mat.diffuse && g.vertices) {
       rep << "; its lobe given to the vertices without one of their own? on " << g.vertices << " such vertices of the subsample, "
           << g.samples << " held-out samples (grazing ones included): mean CIEDE2000 " << fixed(g.mean_with(), 3)
-          << " with it, " << fixed(g.mean_without(), 3) << " without (per vertex " << fixed(g.diff_sum / double(g.vertices), 3)
+          << " with it, " << fixed(g.mean_without(), 3) << " without (per vertex " << fixed(g.mean_difference(), 3)
           << " +- " << fixed(g.standard_error(), 3) << "): ";
       if (g.gives(mo))
         rep << "given";
@@ -276,7 +275,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   rep << "  vertices given a lobe that had none: " << R.vertices_changed_to_specular
       << "; vertices set diffuse (in a diffuse material): " << R.vertices_set_diffuse << "; samples kept "
       << fixed(double(R.bytes_kept) / (1 << 20), 1) << " MB; " << fixed(R.seconds, 2) << " s (CPU, double; choosing K on "
-      << count_eligible(sel) << " vertices " << fixed(seconds_choice, 2) << " s)\n";
+      << sel.verts.size() << " vertices " << fixed(seconds_choice, 2) << " s)\n";
   R.report = rep.str();
   return R;
 }
