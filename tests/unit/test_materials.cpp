@@ -306,6 +306,35 @@ TEST(Materials, ALobeThatLightsDarkGrazingSamplesIsNotGiven) {
     ASSERT_EQ(dark.before[v].ks, plain.before[v].ks) << "vertex " << v;
 }
 
+// The scene with every training sample (raster % 4 != 3) of the vertices at x < -0.8 (two columns
+// of the glossy half) dropped: the training photos of the stage's split never see them, only its
+// held-out ones do (as one camera's vertices in a two-camera project of 4 photos).
+Scene seen_only_by_heldout_photos(const Scene &sc) {
+  Scene out = sc;
+  out.chunk.samples.clear();
+  out.chunk.offsets.assign(1, 0);
+  for (uint32_t v = 0; v < sc.chunk.vertex_count; ++v) {
+    const bool strip = sc.mesh.positions[3 * v] < -0.8f;
+    for (uint32_t k = sc.chunk.offsets[v]; k < sc.chunk.offsets[v + 1]; ++k)
+      if (!strip || sc.chunk.samples[k].raster % 4 == 3) out.chunk.samples.push_back(sc.chunk.samples[k]);
+    out.chunk.offsets.push_back(uint32_t(out.chunk.samples.size()));
+  }
+  return out;
+}
+
+// Vertices that no training photo of the giving test sees are no evidence about a lobe: both of its
+// answers there are guesses (the one without a lobe is black, ~38 CIEDE2000), and counted they swamp
+// what the seen vertices show (checked: with them the lobe is NOT given, 38.17 against 38.25). Left
+// out and said so, the lobeless vertices the training photos see decide, and the lobe helps them.
+TEST(Materials, VerticesNoTrainingPhotoSeesAreNoEvidenceAboutALobe) {
+  const Scene sc = seen_only_by_heldout_photos(make_scene(true, 0.5f, 30.0f, 7));
+  const StageRun r = run_stage(sc);
+  ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
+  EXPECT_NE(r.result.report.find("no training photo sees them"), std::string::npos) << r.result.report;
+  EXPECT_NE(r.result.report.find(": given"), std::string::npos) << r.result.report;
+  EXPECT_GT(r.result.vertices_changed_to_specular, 0u) << r.result.report;
+}
+
 TEST(Materials, ByDefaultOwnLobesAreKeptAndTheOthersGetTheMaterials) {
   const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
   const StageRun r = run_stage(sc);

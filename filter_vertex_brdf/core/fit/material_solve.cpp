@@ -198,9 +198,13 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     const int32_t m = label[v];
     tested[v] = m > 0 && !diffuse[size_t(m)] && !keeps_own_fit(sel.mo, false, fits[v]);
   }
+  std::vector<size_t> unjudged(size_t(K) + 1, 0);
+  for (uint32_t v : sel.verts)
+    if (tested[v] && S_train[v].n == 0) tested[v] = 0, ++unjudged[size_t(label[v])];
   Params P;  // with the lobe (the chosen priors), fitted on the training photos
   solve_vertices(sel, S_train, S_train, kTrain, kTrain, label, train_lobes, diffuse, K, {choice}, &P, &tested);
   std::vector<GivingTest> out(size_t(K) + 1);
+  for (int m = 1; m <= K; ++m) out[size_t(m)].unjudged = unjudged[size_t(m)];
   const MaterialSampleStore &store = sel.store;
   for (uint32_t v : sel.verts) {
     if (!tested[v]) continue;

@@ -57,11 +57,15 @@ bool keeps_own_fit(const MaterialOptions &mo, bool diffuse_material, const Verte
 // Whether a glossy material's lobe predicts the held-out photos of its vertices that have no lobe of
 // their own better than no lobe does (the per-vertex fit's diffuse-only answer), in CIEDE2000 per
 // held-out sample (clean and grazing) over step 1's subsample, the lobes refitted on the training
-// photos of the final labels (MaterialOptions::min_giving_gain, giving_confidence).
+// photos of the final labels (MaterialOptions::min_giving_gain, giving_confidence). Only vertices
+// that the training photos see (at least one training sample in the store) are judged: without
+// one, both answers are guesses (no diffuse colour at all), and "a lobe beats black" is no evidence
+// (with 4 photos of two cameras, most of one camera's vertices have only the held-out photo).
 struct GivingTest {
   double with_lobe = 0, without_lobe = 0;  // summed CIEDE2000 over the held-out samples
   double diff_sq = 0;  // sum over the vertices of (their summed CIEDE2000 with minus without)^2
-  size_t vertices = 0;                     // subsample vertices without a lobe of their own
+  size_t vertices = 0;                     // judged subsample vertices without a lobe of their own
+  size_t unjudged = 0;                     // such vertices without a training sample (left out)
   size_t samples = 0;
   double mean_with() const { return samples ? with_lobe / double(samples) : 0; }
   double mean_without() const { return samples ? without_lobe / double(samples) : 0; }
@@ -72,8 +76,9 @@ struct GivingTest {
     const double n = double(vertices), mean = mean_difference();
     return std::sqrt(std::max(0.0, diff_sq / n - mean * mean) / (n - 1));
   }
+  // With no vertex to judge: given only when there was none to give to (no evidence is no gain).
   bool gives(const MaterialOptions &mo) const {
-    if (vertices == 0) return true;
+    if (vertices == 0) return unjudged == 0;
     if (vertices < 2) return false;
     return with_lobe < (1 - double(mo.min_giving_gain)) * without_lobe &&
            mean_difference() + double(mo.giving_confidence) * standard_error() < 0;
