@@ -101,8 +101,10 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   // results as in turn: every loop's sums are per vertex or in a fixed order.
   std::vector<Config> config_of(size_t(kmax) + 1);
   std::vector<std::vector<double>> error_of(size_t(kmax) + 1);
+  // Largest K first: the dearest clustering starts at once and the cheap ones fill in around it.
 #pragma omp parallel for schedule(dynamic, 1) if (kmax > 1)
-  for (int K = 1; K <= kmax; ++K) {
+  for (int i = 0; i < kmax; ++i) {
+    const int K = kmax - i;
     Context ck = sel;
     SpreadRingCache rings_k;
     std::vector<std::vector<Lobe>> lobes_k;
