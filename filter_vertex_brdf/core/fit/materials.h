@@ -90,7 +90,7 @@ struct MaterialOptions {
   // samples include the grazing ones the fits leave out (N.L < T_d): a relit lobe lights them too.
   // Only vertices with a training sample are judged (as in the choice of K): without one, the
   // answer without a lobe is black and "a lobe beats black" is no evidence (synth_two_views with 4
-  // photos, 2 per camera: a lobe was given on such vertices, 463 of 1 790, and its relit error rose
+  // photos, 3 of one camera and the held-out one of the other: a lobe was given on such vertices, 463 of 1 790, and its relit error rose
   // 1.68 -> 2.19; judged on the others the lobe hurts, 3.08 against 2.00). With none judged, a lobe
   // is given only where no vertex lacked one.
   // Measured (mean held-out CIEDE2000 without -> with, paired t): spot -10.6 % (t -13.7), its second
