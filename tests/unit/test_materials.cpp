@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <algorithm>
 #include <random>
 #include <vector>
@@ -330,9 +331,49 @@ TEST(Materials, VerticesNoTrainingPhotoSeesAreNoEvidenceAboutALobe) {
   const Scene sc = seen_only_by_heldout_photos(make_scene(true, 0.5f, 30.0f, 7));
   const StageRun r = run_stage(sc);
   ASSERT_EQ(r.result.chosen_k, 2) << r.result.report;
-  EXPECT_NE(r.result.report.find("no training photo sees them"), std::string::npos) << r.result.report;
+  EXPECT_NE(r.result.report.find("photos do not see them"), std::string::npos) << r.result.report;
   EXPECT_NE(r.result.report.find(": given"), std::string::npos) << r.result.report;
   EXPECT_GT(r.result.vertices_changed_to_specular, 0u) << r.result.report;
+}
+
+// The scene without the held-out photos' samples (raster % 4 == 3) of the vertices `strip` marks.
+Scene unseen_by_heldout_photos(const Scene &sc, const std::vector<uint8_t> &strip) {
+  Scene out = sc;
+  out.chunk.samples.clear();
+  out.chunk.offsets.assign(1, 0);
+  for (uint32_t v = 0; v < sc.chunk.vertex_count; ++v) {
+    for (uint32_t k = sc.chunk.offsets[v]; k < sc.chunk.offsets[v + 1]; ++k)
+      if (!strip[v] || sc.chunk.samples[k].raster % 4 != 3) out.chunk.samples.push_back(sc.chunk.samples[k]);
+    out.chunk.offsets.push_back(uint32_t(out.chunk.samples.size()));
+  }
+  return out;
+}
+
+// Nor are vertices that no held-out photo sees: they add a paired difference of exactly 0 and pull
+// the mean towards "no gain" (synth_linear16 at 4 photos: 69 of 73 vertices, -0.44 +- 0.26 where the
+// 4 seen ones give -8.0 +- 2.9). Two in three of the scene's lobeless glossy vertices lose their
+// held-out samples; the test counts only the others, each with its held-out samples (checked to fail
+// when they are counted: 57 vertices for 80 samples).
+TEST(Materials, VerticesNoHeldOutPhotoSeesAreNoEvidenceEither) {
+  const Scene sc = make_scene(true, 0.5f, 30.0f, 7);
+  const StageRun plain = run_stage(sc);
+  std::vector<uint8_t> strip(sc.truth.size(), 0);
+  size_t lobeless = 0;
+  for (size_t v = 0; v < sc.truth.size(); ++v)
+    if (sc.truth[v] == 1 && !(plain.before[v].ks > 0)) strip[v] = (lobeless++ % 3) != 0;
+  const StageRun r = run_stage(unseen_by_heldout_photos(sc, strip));
+  const std::string &rep = r.result.report;
+  const size_t at = rep.find("its lobe given to the vertices without one of their own? on ");
+  ASSERT_NE(at, std::string::npos) << rep;
+  unsigned vertices = 0, samples = 0;
+  const size_t comma = rep.find(", ", at);
+  ASSERT_EQ(std::sscanf(rep.c_str() + at, "its lobe given to the vertices without one of their own? on %u", &vertices), 1) << rep;
+  ASSERT_EQ(std::sscanf(rep.c_str() + comma, ", %u held-out samples", &samples), 1) << rep;
+  EXPECT_GT(vertices, 0u) << rep;
+  // Every judged vertex brings its held-out samples: 4 here (a few may face away from a light).
+  EXPECT_GE(samples, 3u * vertices) << rep;
+  EXPECT_LE(samples, 4u * vertices) << rep;
+  EXPECT_NE(rep.find(": given"), std::string::npos) << rep;
 }
 
 TEST(Materials, ByDefaultOwnLobesAreKeptAndTheOthersGetTheMaterials) {

@@ -213,6 +213,7 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     const LobeAt lobe(P.alpha[v], sel.ggx);
     GivingTest &g = out[size_t(label[v])];
     double with_sum = 0, without_sum = 0;
+    const size_t samples_before = g.samples;
     auto score = [&](const Entry &e, float key) {
       if (!sel.in_set(e, kHeld)) return;
       const double gk = lobe(key);
@@ -227,6 +228,10 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     for (uint64_t k = store.first(v); k < store.last(v); ++k) score(store.entries()[k], (*sel.lobe_keys)[k]);
     for (uint64_t k = store.grazing_first(v); k < store.grazing_last(v); ++k)
       score(store.grazing_entries()[k], lobe_key(store.grazing_entries()[k].s, sel.ggx));
+    if (g.samples == samples_before) {  // no held-out sample: no evidence either way
+      ++g.unjudged;
+      continue;
+    }
     g.with_lobe += with_sum, g.without_lobe += without_sum;
     g.diff_sq += (with_sum - without_sum) * (with_sum - without_sum);
     ++g.vertices;

@@ -60,12 +60,15 @@ bool keeps_own_fit(const MaterialOptions &mo, bool diffuse_material, const Verte
 // photos of the final labels (MaterialOptions::min_giving_gain, giving_confidence). Only vertices
 // that the training photos see (at least one training sample in the store) are judged: without
 // one, both answers are guesses (no diffuse colour at all), and "a lobe beats black" is no evidence
-// (with 4 photos of two cameras, most of one camera's vertices have only the held-out photo).
+// (with 4 photos of two cameras, most of one camera's vertices have only the held-out photo). Nor
+// are vertices without a held-out sample: a paired difference of exactly 0 is no evidence either,
+// and counted it pulls the mean towards "no gain".
 struct GivingTest {
   double with_lobe = 0, without_lobe = 0;  // summed CIEDE2000 over the held-out samples
   double diff_sq = 0;  // sum over the vertices of (their summed CIEDE2000 with minus without)^2
   size_t vertices = 0;                     // judged subsample vertices without a lobe of their own
-  size_t unjudged = 0;                     // such vertices without a training sample (left out)
+                                           //   (with a training and a held-out sample)
+  size_t unjudged = 0;                     // such vertices without a training or a held-out sample (left out)
   size_t samples = 0;
   double mean_with() const { return samples ? with_lobe / double(samples) : 0; }
   double mean_without() const { return samples ? without_lobe / double(samples) : 0; }

@@ -259,7 +259,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     const GivingTest &g = giving[size_t(m)];
     if (!mat.diffuse && (g.vertices || g.unjudged)) {
       rep << "; its lobe given to the vertices without one of their own? on " << g.vertices << " such vertices of the subsample";
-      if (g.unjudged) rep << " (" << g.unjudged << " more left out: no training photo sees them)";
+      if (g.unjudged) rep << " (" << g.unjudged << " more left out: the split's training or held-out photos do not see them)";
       rep << ", " << g.samples << " held-out samples (grazing ones included): mean CIEDE2000 " << fixed(g.mean_with(), 3)
           << " with it, " << fixed(g.mean_without(), 3) << " without (per vertex " << fixed(g.mean_difference(), 3)
           << " +- " << fixed(g.standard_error(), 3) << "): ";
