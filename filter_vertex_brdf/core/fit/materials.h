@@ -91,8 +91,10 @@ struct MaterialOptions {
   // Only vertices with a training sample are judged (as in the choice of K): without one, the
   // answer without a lobe is black and "a lobe beats black" is no evidence (synth_two_views with 4
   // photos, 3 of one camera and the held-out one of the other: a lobe was given on such vertices, 463 of 1 790, and its relit error rose
-  // 1.68 -> 2.19; judged on the others the lobe hurts, 3.08 against 2.00). With none judged, a lobe
-  // is given only where no vertex lacked one.
+  // 1.68 -> 2.19; judged on the others the lobe hurts, 3.08 against 2.00); nor vertices without a
+  // held-out sample (their paired difference of 0 diluted synth_linear16's 4-photo test: -0.44 +-
+  // 0.26 on 73 vertices, where the 4 seen ones give -8.0 +- 2.9). With none judged, a lobe is given
+  // only where no vertex lacked one.
   // Measured (mean held-out CIEDE2000 without -> with, paired t): spot -10.6 % (t -13.7), its second
   // camera -5.0 % (-13.0), bunny's glossy material -2.7 % (-12.9), the 100 k benchmark scene -14.5 %
   // (-6.1), synth_linear16's three glossy materials -24 / -64 / -24 % (-3.2 / -3.4 / -3.8): given;
