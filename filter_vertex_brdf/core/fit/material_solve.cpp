@@ -193,19 +193,27 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
                                     const std::vector<uint8_t> &diffuse, int K, const Choice &choice,
                                     const std::vector<VertexFit> &fits) {
   const std::vector<LobeFit> train_lobes = fit_lobes(sel, kTrain, S_train, label, K);
+  const MaterialSampleStore &store = sel.store;
+  auto has_heldout_sample = [&](uint32_t v) {
+    for (uint64_t k = store.first(v); k < store.last(v); ++k)
+      if (sel.in_set(store.entries()[k], kHeld)) return true;
+    for (uint64_t k = store.grazing_first(v); k < store.grazing_last(v); ++k)
+      if (sel.in_set(store.grazing_entries()[k], kHeld)) return true;
+    return false;
+  };
+  // The vertices without a lobe of their own; of them, those both sides of the split see are judged.
+  std::vector<GivingTest> out(size_t(K) + 1);
   std::vector<uint8_t> tested(sel.n, 0);
   for (uint32_t v : sel.verts) {
     const int32_t m = label[v];
-    tested[v] = m > 0 && !diffuse[size_t(m)] && !keeps_own_fit(sel.mo, false, fits[v]);
+    if (m <= 0 || diffuse[size_t(m)] || keeps_own_fit(sel.mo, false, fits[v])) continue;
+    if (S_train[v].n > 0 && has_heldout_sample(v))
+      tested[v] = 1;
+    else
+      ++out[size_t(m)].unjudged;
   }
-  std::vector<size_t> unjudged(size_t(K) + 1, 0);
-  for (uint32_t v : sel.verts)
-    if (tested[v] && S_train[v].n == 0) tested[v] = 0, ++unjudged[size_t(label[v])];
   Params P;  // with the lobe (the chosen priors), fitted on the training photos
   solve_vertices(sel, S_train, S_train, kTrain, kTrain, label, train_lobes, diffuse, K, {choice}, &P, &tested);
-  std::vector<GivingTest> out(size_t(K) + 1);
-  for (int m = 1; m <= K; ++m) out[size_t(m)].unjudged = unjudged[size_t(m)];
-  const MaterialSampleStore &store = sel.store;
   for (uint32_t v : sel.verts) {
     if (!tested[v]) continue;
     double rho[3];  // without a lobe: the diffuse-only least squares on the training photos
@@ -213,7 +221,6 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     const LobeAt lobe(P.alpha[v], sel.ggx);
     GivingTest &g = out[size_t(label[v])];
     double with_sum = 0, without_sum = 0;
-    const size_t samples_before = g.samples;
     auto score = [&](const Entry &e, float key) {
       if (!sel.in_set(e, kHeld)) return;
       const double gk = lobe(key);
@@ -228,10 +235,6 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     for (uint64_t k = store.first(v); k < store.last(v); ++k) score(store.entries()[k], (*sel.lobe_keys)[k]);
     for (uint64_t k = store.grazing_first(v); k < store.grazing_last(v); ++k)
       score(store.grazing_entries()[k], lobe_key(store.grazing_entries()[k].s, sel.ggx));
-    if (g.samples == samples_before) {  // no held-out sample: no evidence either way
-      ++g.unjudged;
-      continue;
-    }
     g.with_lobe += with_sum, g.without_lobe += without_sum;
     g.diff_sq += (with_sum - without_sum) * (with_sum - without_sum);
     ++g.vertices;
