@@ -4,7 +4,7 @@
 //   vbrdf_bench fit --project P.mlp [--lp L.lp] [--photo-dir D] [--photos N] [--mesh M.ply]
 //                   [--backend gpu|cpu|cpu-all] [--iterations N] [--heldout H.mlp [--heldout-lp L]
 //                   [--heldout-photo-dir D]] [--gt GT.ply [--albedo-factors f0,f1,...]] --work DIR
-//                   [--relight-dir DIR] [--name NAME] [--materials on|off]
+//                   [--relight-dir DIR] [--name NAME] [--materials on|off] [--min-heldout-photos N]
 //       One configuration: runs the filter's pipeline (run_fit) timed per stage, then scores it:
 //       held-out relit error in image space (relight_render.h; the held-out photos colour-corrected
 //       from their chart as the fit corrects its samples) and the parameter error against a ground
@@ -15,7 +15,8 @@
 //       GPU (compute shader) fit, cpu = OpenGL visibility + CPU fit, cpu-all = CPU ray-cast
 //       visibility + CPU fit. --albedo-factors: per material_id factor on the GT albedo (the
 //       Lambertian-equivalent albedo of a coated material, shared scenes). --materials: the
-//       material stage (default: the filter's, on).
+//       material stage (default: the filter's, on); --min-heldout-photos: its MaterialOptions value
+//       (1: one held-out split whatever the photo count).
 //   vbrdf_bench decimate --in M.ply --out O.ply --vertices N
 //   vbrdf_bench srgb8 --in-dir D --out-dir D2      16-bit linear PNGs -> 8-bit sRGB PNGs
 //   vbrdf_bench plot --points P.csv --out plot.png [--title T] [--x-label X] [--y-label Y]
@@ -340,6 +341,7 @@ FitSettings settings_for(const Args &a, const std::string &work, const std::stri
   const std::string materials = a.get("materials", s.materials ? "on" : "off");
   if (materials != "on" && materials != "off") throw InputError("--materials must be on or off (got '" + materials + "')");
   s.materials = materials == "on";
+  if (!a.get("min-heldout-photos").empty()) s.material_options.min_heldout_photos = size_t(std::stoul(a.get("min-heldout-photos")));
   s.light_file = lp;
   s.output_ply = join_path(work, "fit.ply");
   return s;

@@ -32,6 +32,7 @@ int usage() {
                "                 [--iterations N] [--alpha0 X] [--min-specular N] [--photo-dir D]\n"
                "                 [--color-correction off|auto|required] [--no-remedies]\n"
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
+               "                 [--min-heldout-photos N]\n"
                "                 [--photo-shadows on|off]\n"
                "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n";
   return 2;
@@ -73,6 +74,7 @@ int main(int argc, char **argv) {
     else if (a == "--material-lobes-everywhere") settings.material_options.keep_full_fits = false;
     else if (a == "--no-robust-colour") settings.material_options.robust_colour = false;
     else if (a == "--max-materials") settings.material_options.max_materials = std::stoi(next());
+    else if (a == "--min-heldout-photos") settings.material_options.min_heldout_photos = size_t(std::stoul(next()));
     else if (a == "--color-correction") {
       const std::string v = next();
       if (v == "off") settings.color_correction = ColorCorrectionChoice::Off;

@@ -86,21 +86,3 @@ TEST(DiffuseForm, NamesRoundTrip) {
 
 } // namespace
 } // namespace vbrdf
-
-namespace vbrdf {
-namespace {
-// The diffuse-form pilot holds out folds in turn until 8 photos were held out once: one fold
-// (raster % 4 == 3) from 32 photos on, two for 16-31, all four for the thesis's 8-12.
-TEST(DiffuseChoice, PilotFoldsHoldOutAtLeastEightPhotos) {
-  EXPECT_EQ(diffuse_pilot_folds(32), 1);
-  EXPECT_EQ(diffuse_pilot_folds(64), 1);
-  EXPECT_EQ(diffuse_pilot_folds(31), 2);  // fold 3 holds out 7
-  EXPECT_EQ(diffuse_pilot_folds(24), 2);
-  EXPECT_EQ(diffuse_pilot_folds(16), 2);
-  EXPECT_EQ(diffuse_pilot_folds(12), 3);
-  EXPECT_EQ(diffuse_pilot_folds(9), 4);
-  EXPECT_EQ(diffuse_pilot_folds(4), 4);
-  EXPECT_EQ(diffuse_pilot_folds(0), 4);
-}
-} // namespace
-} // namespace vbrdf

@@ -14,9 +14,6 @@
 namespace vbrdf {
 namespace {
 
-constexpr int kFolds = 4;          // every 4th photo held out
-constexpr int kFoldOrder[kFolds] = {3, 1, 2, 0};  // the folds held out in turn (3 alone: >= 32 photos)
-constexpr size_t kMinHeldOutPhotos = 8;
 constexpr size_t kMinPhotosSeen = 4;
 constexpr size_t kMinPilotVertices = 50;
 constexpr size_t kVoteNeighbours = 9;       // majority over the nearest labelled pilot vertices
@@ -24,26 +21,8 @@ constexpr double kMinLabelShare = 0.05;     // a coat map needs each label on >=
 
 enum MapLabel : int8_t { kUnlabelled = -1, kBare = 0, kCoated = 1 };
 
-bool held_out(const Sample &s, int fold) { return s.raster % kFolds == fold; }
-
-} // namespace
-
-// With 9 photos one fold holds out 2, and two lights decided the form: on the Seitz cat (sRGB) a
-// coat map 6 % better on them was 19 % worse on three other lights.
-int diffuse_pilot_folds(size_t photos) {
-  int folds = 0;
-  size_t held = 0;
-  while (folds < kFolds && held < kMinHeldOutPhotos) {
-    const int f = kFoldOrder[folds++];
-    held += photos > size_t(f) ? (photos - size_t(f) + kFolds - 1) / kFolds : 0;
-  }
-  return folds;
-}
-
-namespace {
-
 std::string folds_note(size_t photos) {
-  const int folds = diffuse_pilot_folds(photos);
+  const int folds = heldout_fold_count(photos);
   return folds > 1 ? ", " + std::to_string(folds) + " folds in turn" : std::string();
 }
 
@@ -80,7 +59,7 @@ std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Rast
                                     PhotoCache &photos, const std::function<void(SampleChunk &)> &prepare) {
   gather.diffuse = DiffuseForms::everywhere(form);
   gather.resolution_weights = false;
-  const int folds = diffuse_pilot_folds(rasters.size());
+  const int folds = heldout_fold_count(rasters.size());
   std::vector<PilotVertex> out;
   gather_samples(mesh, rasters, lights, pilot, gather, photos, [&](SampleChunk &chunk) {
     if (prepare) prepare(chunk);
@@ -101,16 +80,15 @@ std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Rast
         PilotVertex &p = scored[size_t(n)];
         p.vertex = chunk.first_vertex + i;
         for (int k = 0; k < folds; ++k) {
-          const int fold = kFoldOrder[k];
           train.clear();
           for (const Sample *s = begin; s != end; ++s)
-            if (!held_out(*s, fold)) train.push_back(*s);
+            if (!held_out_in_fold(s->raster, k)) train.push_back(*s);
           VertexFit fit;
           fit_vertex_cpu(train.data(), train.size(), phong, fit);
           if (!has_model(fit)) continue;
           modelled[size_t(n)] = 1;
           for (const Sample *s = begin; s != end; ++s) {
-            if (!held_out(*s, fold) || !scorable(*s)) continue;
+            if (!held_out_in_fold(s->raster, k) || !scorable(*s)) continue;
             float predicted[3];
             evaluate_phong(fit, s->d, s->lobe_cos, phong.lobe, predicted);
             for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;

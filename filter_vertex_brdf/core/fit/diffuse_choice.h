@@ -18,8 +18,7 @@
 //   correction and light fall-off as the fit), fitted on the photos with raster % 4 != f by the
 //   CPU reference (fit_vertex_cpu), and scored on the usable samples (lit, unsaturated, clean,
 //   d > 0) of the photos with raster % 4 == f: mean absolute RGB error. Folds f = 3, 1, 2, 0 in
-//   turn until at least 8 photos were held out (one fold from 32 photos on, all four below 16):
-//   with few photos, one fold's two or three lights are too few to decide on.
+//   turn until at least 8 photos were held out (heldout_folds.h, shared with the material stage).
 // - Coat map: a pilot vertex is labelled coated when its 9 nearest other pilot vertices (3-D
 //   distance; itself left out) together predict their held-out photos better coated than
 //   Lambertian; every mesh vertex then takes the label of the nearest pilot vertex over the mesh's
@@ -34,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/heldout_folds.h"
 #include "fit/phong_fit.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
@@ -41,10 +41,6 @@
 #include "samples/samples.h"
 
 namespace vbrdf {
-
-// How many of the four folds (raster % 4 == 3, 1, 2, 0) the pilot holds out in turn for a capture
-// of `photos` photos: until at least 8 photos were held out once.
-int diffuse_pilot_folds(size_t photos);
 
 struct DiffuseChoice {
   DiffuseForms forms;            // the choice (uniform, or a per-vertex coat map)

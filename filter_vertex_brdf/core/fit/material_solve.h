@@ -70,6 +70,13 @@ struct GivingTest {
                                            //   (with a training and a held-out sample)
   size_t unjudged = 0;                     // such vertices without a training or a held-out sample (left out)
   size_t samples = 0;
+  // Pools another split's test (the folds of heldout_folds.h): each (vertex, split) pair
+  // is one paired difference.
+  GivingTest &operator+=(const GivingTest &o) {
+    with_lobe += o.with_lobe, without_lobe += o.without_lobe, diff_sq += o.diff_sq;
+    vertices += o.vertices, unjudged += o.unjudged, samples += o.samples;
+    return *this;
+  }
   double mean_with() const { return samples ? with_lobe / double(samples) : 0; }
   double mean_without() const { return samples ? without_lobe / double(samples) : 0; }
   // Mean per-vertex difference (with minus without) and its standard error (0 for fewer than two vertices).

@@ -51,7 +51,7 @@ struct Context {
   // at once): lobe_sums_at then writes only the entries it computes (one pool per context).
   std::vector<std::vector<Lobe>> *lobe_buffers = nullptr;
 
-  // Per raster index (Entry::raster is 16 bits): 1 when it is held out (every heldout_every-th
+  // Per raster index (Entry::raster is 16 bits): 1 when it is held out (this context's fold of heldout_folds.h,
   // raster), filled by fit_materials; a table, not a division per sample in the loops.
   const std::vector<uint8_t> *held_raster = nullptr;
 

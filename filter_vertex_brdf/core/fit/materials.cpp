@@ -1,6 +1,7 @@
 #include "fit/materials.h"
 
 #include "base/mesh_adjacency.h"
+#include "fit/heldout_folds.h"
 #include "fit/label_spread.h"
 #include "fit/material_labels.h"
 #include "fit/material_solve.h"
@@ -34,6 +35,55 @@ Context selection_subsample(const Context &c, size_t eligible) {
   return sel;
 }
 
+// Merges a configuration's materials that have the same lobe: both diffuse (diffuse_flags), or both
+// glossy with k_s and alpha within mo.twin_lobe_tolerance of each other (relative to the larger);
+// the labels are renumbered 1..K' in order and the lobes refitted on `set`. Returns K - K'.
+int merge_twin_materials(const Context &c, const std::vector<Static> &S, int set, const std::vector<VertexFit> &fits,
+                         const MaterialOptions &mo, Config &cfg) {
+  if (cfg.K < 2) return 0;
+  const std::vector<uint8_t> diffuse = diffuse_flags(cfg.lobes, median_kd_of(c, fits, cfg.label, cfg.K), cfg.K, mo, c.o.lobe);
+  auto close = [&](double a, double b) { return std::fabs(a - b) <= double(mo.twin_lobe_tolerance) * std::max(a, b); };
+  std::vector<int> root(size_t(cfg.K) + 1);
+  for (int m = 0; m <= cfg.K; ++m) root[size_t(m)] = m;
+  for (int i = 1; i <= cfg.K; ++i)
+    for (int j = i + 1; j <= cfg.K; ++j) {
+      if (root[size_t(j)] != j) continue;  // already merged into an earlier one
+      const LobeFit &a = cfg.lobes[size_t(i)], &b = cfg.lobes[size_t(j)];
+      const bool twins = (diffuse[size_t(i)] && diffuse[size_t(j)]) ||
+                         (!diffuse[size_t(i)] && !diffuse[size_t(j)] && close(a.ks, b.ks) && close(a.alpha, b.alpha));
+      if (twins) root[size_t(j)] = root[size_t(i)];
+    }
+  std::vector<int32_t> renumbered(size_t(cfg.K) + 1, 0);
+  int k = 0;
+  for (int m = 1; m <= cfg.K; ++m) renumbered[size_t(m)] = root[size_t(m)] == m ? ++k : renumbered[size_t(root[size_t(m)])];
+  const int merged = cfg.K - k;
+  if (!merged) return 0;
+  for (int32_t &l : cfg.label)
+    if (l > 0) l = renumbered[size_t(l)];
+  cfg.K = k;
+  cfg.lobes = fit_lobes(c, set, S, cfg.label, k);
+  return merged;
+}
+
+// Per raster index (16 bits): 1 when the raster has samples in the store (normal or grazing).
+std::vector<uint8_t> rasters_present(const MaterialSampleStore &store) {
+  std::vector<uint8_t> present(size_t(1) << 16, 0);
+  for (const MaterialSampleStore::Entry &e : store.entries()) present[e.raster] = 1;
+  for (const MaterialSampleStore::Entry &e : store.grazing_entries()) present[e.raster] = 1;
+  return present;
+}
+
+// Per fold of heldout_folds.h taken for the store's photos, per raster index: 1 when held out.
+std::vector<std::vector<uint8_t>> held_out_tables(const std::vector<uint8_t> &present, size_t min_held) {
+  std::vector<std::vector<uint8_t>> tables;
+  for (int k : heldout_folds(present, min_held)) {
+    std::vector<uint8_t> held(present.size(), 0);
+    for (size_t r = 0; r < held.size(); ++r) held[r] = held_out_in_fold(r, k);
+    tables.push_back(std::move(held));
+  }
+  return tables;
+}
+
 std::string fixed(double v, int digits) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
@@ -64,10 +114,14 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     R.report = "materials: no vertex with samples: stage skipped\n";
     return R;
   }
-  std::vector<uint8_t> held_raster(size_t(1) << 16, 0);
-  for (size_t r = 0; r < held_raster.size(); ++r)
-    held_raster[r] = mo.heldout_every > 1 && (r % size_t(mo.heldout_every)) == size_t(mo.heldout_every - 1);
-  c.held_raster = &held_raster;
+  // The held-out splits (heldout_folds.h): below pool_folds_below photos folds until
+  // min_heldout_photos were held out, else one.
+  const std::vector<uint8_t> present = rasters_present(store);
+  const size_t photos = size_t(std::count(present.begin(), present.end(), uint8_t(1)));
+  const std::vector<std::vector<uint8_t>> held_rasters =
+      held_out_tables(present, photos < mo.pool_folds_below ? mo.min_heldout_photos : 1);
+  c.held_raster = &held_rasters.front();
+  R.folds = int(held_rasters.size());
   std::vector<float> lobe_keys(store.entries().size());
   c.ggx = o.lobe == LobeForm::GgxNH;
   for (size_t k = 0; k < lobe_keys.size(); ++k) lobe_keys[k] = lobe_key(store.entries()[k].s, c.ggx);
@@ -80,51 +134,66 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   c.rings = &rings_all, c.lobe_buffers = &lobes_all;
   std::ostringstream rep;
 
-  // 1. Choose K and the prior on the training photos, by the error at the held-out ones, on an
-  // even subsample of the eligible vertices (selection_subsample).
+  // 1. Choose K and the prior on the training photos, by the error at the held-out ones (summed
+  // over the folds), on an even subsample of the eligible vertices (selection_subsample).
   Context sel = selection_subsample(c, eligible);
   SpreadRingCache rings_sel;
   std::vector<std::vector<Lobe>> lobes_sel;
   sel.rings = &rings_sel, sel.lobe_buffers = &lobes_sel;
-  const std::vector<Static> S_train = static_sums(sel, kTrain), S_held = static_sums(sel, kHeld);
+  const size_t n_folds = held_rasters.size();
+  std::vector<std::vector<Static>> S_train(n_folds), S_held(n_folds);
+  std::vector<std::vector<LobeFit>> one(n_folds);
   std::vector<int32_t> ones(c.n, 0);
   for (size_t v = 0; v < c.n; ++v) ones[v] = sel.eligible[v] ? 1 : 0;
-  const std::vector<LobeFit> one = fit_lobes(sel, kTrain, S_train, ones, 1);
+  for (size_t f = 0; f < n_folds; ++f) {
+    sel.held_raster = &held_rasters[f];
+    S_train[f] = static_sums(sel, kTrain), S_held[f] = static_sums(sel, kHeld);
+    one[f] = fit_lobes(sel, kTrain, S_train[f], ones, 1);
+  }
+  sel.held_raster = &held_rasters.front();
   std::vector<Config> configs;
   std::vector<Choice> best_choice, choices;
   for (float prior : mo.prior_strengths)
     for (float alpha_prior : mo.alpha_prior_strengths) choices.push_back({prior, alpha_prior});
   if (choices.empty()) choices.push_back({1.0f, -1.0f});
   const int kmax = std::max(1, mo.max_materials);
-  // The K are independent: clustered and scored concurrently, each with its own caches (the loops
-  // inside then run on one thread: on the 3 000-vertex subsample they parallelise poorly). The same
-  // results as in turn: every loop's sums are per vertex or in a fixed order.
+  // The (K, fold) pairs are independent: clustered and scored concurrently, each with its own
+  // caches (the loops inside then run on one thread: on the 3 000-vertex subsample they parallelise
+  // poorly). The same results as in turn: every loop's sums are per vertex or in a fixed order.
+  // Fold 0's configuration is the one kept for step 2 (the others only score).
   std::vector<Config> config_of(size_t(kmax) + 1);
-  std::vector<std::vector<double>> error_of(size_t(kmax) + 1);
+  std::vector<std::vector<std::vector<double>>> error_of(size_t(kmax) + 1, std::vector<std::vector<double>>(n_folds));
+  const int jobs = kmax * int(n_folds);
   // Largest K first: the dearest clustering starts at once and the cheap ones fill in around it.
-#pragma omp parallel for schedule(dynamic, 1) if (kmax > 1)
-  for (int i = 0; i < kmax; ++i) {
-    const int K = kmax - i;
+#pragma omp parallel for schedule(dynamic, 1) if (jobs > 1)
+  for (int i = 0; i < jobs; ++i) {
+    const int K = kmax - i / int(n_folds);
+    const size_t f = size_t(i % int(n_folds));
     Context ck = sel;
+    ck.held_raster = &held_rasters[f];
     SpreadRingCache rings_k;
     std::vector<std::vector<Lobe>> lobes_k;
     ck.rings = &rings_k, ck.lobe_buffers = &lobes_k;
-    Config cfg = K == 1 ? Config{1, ones, one}
-                        : cluster(ck, adj, S_train, kTrain, initial_labels(ck, adj, S_train, kTrain, one[1].alpha, K), K, mo.iterations);
-    if (cfg.K == K || K == 1) {  // else collapsed to fewer materials: nothing new to score
+    Config cfg = K == 1 ? Config{1, ones, one[f]}
+                        : cluster(ck, adj, S_train[f], kTrain, initial_labels(ck, adj, S_train[f], kTrain, one[f][1].alpha, K), K,
+                                  mo.iterations);
+    // Fold 0 collapsed to fewer materials: nothing new to score (another fold's collapse is scored as it is).
+    if (K == 1 || cfg.K == K || f > 0) {
       const std::vector<uint8_t> diffuse = diffuse_flags(cfg.lobes, median_kd_of(ck, fits, cfg.label, cfg.K), cfg.K, mo, c.o.lobe);
-      error_of[size_t(K)] = solve_vertices(ck, S_train, S_held, kTrain, kHeld, cfg.label, cfg.lobes, diffuse, cfg.K, choices, nullptr);
+      error_of[size_t(K)][f] = solve_vertices(ck, S_train[f], S_held[f], kTrain, kHeld, cfg.label, cfg.lobes, diffuse, cfg.K, choices, nullptr);
     }
-    config_of[size_t(K)] = std::move(cfg);
+    if (f == 0) config_of[size_t(K)] = std::move(cfg);
   }
   for (int K = 1; K <= kmax; ++K) {
-    const std::vector<double> &err = error_of[size_t(K)];
-    if (err.empty()) {  // collapsed
+    if (error_of[size_t(K)][0].empty()) {  // collapsed
       R.heldout_error.push_back(R.heldout_error.empty() ? 0 : R.heldout_error.back());
       configs.push_back(std::move(config_of[size_t(K)]));
       best_choice.push_back(best_choice.empty() ? choices.front() : best_choice.back());
       continue;
     }
+    std::vector<double> err = error_of[size_t(K)][0];
+    for (size_t f = 1; f < n_folds; ++f)
+      for (size_t j = 0; j < err.size(); ++j) err[j] += error_of[size_t(K)][f][j];
     const size_t b = size_t(std::min_element(err.begin(), err.end()) - err.begin());
     R.heldout_error.push_back(err[b]);
     configs.push_back(std::move(config_of[size_t(K)]));
@@ -133,14 +202,25 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   const double best_error = *std::min_element(R.heldout_error.begin(), R.heldout_error.end());
   size_t chosen = 0;
   while (chosen + 1 < R.heldout_error.size() && R.heldout_error[chosen] > (1 + mo.choose_tolerance) * best_error) ++chosen;
+  // Materials are told apart by their lobes (colour is no feature): two materials of the same lobe
+  // are one material split in two, which the map would show as regions that are not there: merged.
+  const int k_within_tolerance = configs[chosen].K;
+  const int merged = merge_twin_materials(sel, S_train.front(), kTrain, fits, mo, configs[chosen]);
   R.chosen_prior = best_choice[chosen].prior;
   R.chosen_alpha_prior = best_choice[chosen].alpha_prior;
-  rep << "materials (issue 16): chosen by held-out error (every " << mo.heldout_every << "th photo left out, fitted on the "
-      << "others): ";
+  rep << "materials (issue 16): chosen by held-out error (every 4th photo left out, fitted on the others";
+  if (n_folds > 1)
+    rep << "; " << photos << " photos (fewer than " << mo.pool_folds_below << "): summed over " << n_folds
+        << " such splits, until at least " << mo.min_heldout_photos << " photos were held out";
+  rep << "): ";
   for (size_t k = 0; k < R.heldout_error.size(); ++k)
     rep << (k ? ", " : "") << "K=" << k + 1 << " " << fixed(R.heldout_error[k] / std::max(best_error, 1e-300), 4);
   rep << " (relative to the best); smallest K within " << fixed(100 * mo.choose_tolerance, 1) << " % of the best: "
-      << configs[chosen].K << "; k_s prior strength " << R.chosen_prior << ", per-vertex alpha "
+      << k_within_tolerance;
+  if (merged)
+    rep << ", " << merged << " of whose materials had another's lobe (both diffuse, or k_s and alpha within "
+        << fixed(100 * mo.twin_lobe_tolerance, 0) << " %): merged, K = " << configs[chosen].K;
+  rep << "; k_s prior strength " << R.chosen_prior << ", per-vertex alpha "
       << (R.chosen_alpha_prior < 0 ? std::string("= the material's") : "prior strength " + fixed(R.chosen_alpha_prior, 3))
       << "\n";
 
@@ -180,8 +260,13 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   // misfit: every vertex keeps its own fit (stripping those lobes raises horse's mean / p95 from
   // 2.88 / 6.02 to 2.93 / 6.40 at its held-out lights; ctest psm_real_materials).
   const bool any_glossy = std::count(diffuse.begin() + 1, diffuse.end(), uint8_t(0)) > 0;
-  const std::vector<GivingTest> giving = any_glossy ? test_giving(sel, S_train, fin.label, diffuse, K, best_choice[chosen], fits)
-                                                    : std::vector<GivingTest>(size_t(K) + 1);
+  std::vector<GivingTest> giving(size_t(K) + 1);
+  for (size_t f = 0; any_glossy && f < n_folds; ++f) {
+    sel.held_raster = &held_rasters[f];
+    const std::vector<GivingTest> g = test_giving(sel, S_train[f], fin.label, diffuse, K, best_choice[chosen], fits);
+    for (size_t m = 0; m < giving.size(); ++m) giving[m] += g[m];
+  }
+  sel.held_raster = &held_rasters.front();
   // Vertices that keep their own fit (step 3) need no parameters: on the benchmark scene 38 k of
   // its 54 k, most of this solve's time.
   std::vector<uint8_t> rewritten(c.n, 0);
@@ -259,6 +344,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     const GivingTest &g = giving[size_t(m)];
     if (!mat.diffuse && (g.vertices || g.unjudged)) {
       rep << "; its lobe given to the vertices without one of their own? on " << g.vertices << " such vertices of the subsample";
+      if (n_folds > 1) rep << " (each counted once per split that judges it)";
       if (g.unjudged) rep << " (" << g.unjudged << " more left out: the split's training or held-out photos do not see them)";
       rep << ", " << g.samples << " held-out samples (grazing ones included): mean CIEDE2000 " << fixed(g.mean_with(), 3)
           << " with it, " << fixed(g.mean_without(), 3) << " without (per vertex " << fixed(g.mean_difference(), 3)
