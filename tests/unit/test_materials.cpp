@@ -428,15 +428,25 @@ GivingCounts giving_counts(const std::string &rep) {
   return sum;
 }
 
+// The stage on the scene's first `photos` photos, with one held-out fold and with the default folds.
+struct FoldRuns {
+  StageRun single, pooled;
+};
+FoldRuns one_fold_and_default(const Scene &full, int photos) {
+  const Scene sc = first_photos(full, photos);
+  MaterialOptions one_fold;
+  one_fold.min_heldout_photos = 1;
+  return {run_stage(sc, one_fold), run_stage(sc)};
+}
+
 // With 8 photos one held-out split (every 4th photo) rests on 2 photos; the choice of K and the
 // giving test sum over the folds of heldout_folds.h until 8 photos were held out (here all 4, each
 // photo held out once): 4 times the judged (vertex, split) pairs and held-out samples (synth_basic at
 // 8 photos: relit 0.919 -> 0.813, ctest material_folds_few_photos). Checked to fail with one fold.
 TEST(Materials, WithFewPhotosEveryPhotoIsHeldOutOnce) {
-  const Scene sc = first_photos(make_scene(true, 0.5f, 30.0f, 7), 8);
-  MaterialOptions one_split;
-  one_split.min_heldout_photos = 1;
-  const StageRun single = run_stage(sc, one_split), pooled = run_stage(sc);
+  const Scene full = make_scene(true, 0.5f, 30.0f, 7);
+  const FoldRuns runs = one_fold_and_default(full, 8);
+  const StageRun &single = runs.single, &pooled = runs.pooled;
   EXPECT_EQ(single.result.folds, 1) << single.result.report;
   EXPECT_EQ(pooled.result.folds, 4) << pooled.result.report;
   EXPECT_NE(pooled.result.report.find("summed over 4 such splits"), std::string::npos) << pooled.result.report;
@@ -445,17 +455,15 @@ TEST(Materials, WithFewPhotosEveryPhotoIsHeldOutOnce) {
   EXPECT_GE(four.vertices, 3 * one.vertices) << single.result.report << pooled.result.report;
   EXPECT_GE(four.samples, 3 * one.samples) << single.result.report << pooled.result.report;
   // From pool_folds_below (16) photos on, one fold.
-  const StageRun sixteen = run_stage(make_scene(true, 0.5f, 30.0f, 7));
+  const StageRun sixteen = run_stage(full);
   EXPECT_EQ(sixteen.result.folds, 1) << sixteen.result.report;
 }
 
 // With fewer photos than 4 the first fold (index % 4 == 3) holds none out: it is skipped, and the
 // choice is scored on the folds that do hold one out (once it scored nothing: every K's error 0).
 TEST(Materials, FewerPhotosThanTheSplitStillHoldSomeOut) {
-  const Scene sc = first_photos(make_scene(true, 0.5f, 30.0f, 7), 3);
-  MaterialOptions one_split;
-  one_split.min_heldout_photos = 1;
-  const StageRun single = run_stage(sc, one_split), pooled = run_stage(sc);
+  const FoldRuns runs = one_fold_and_default(make_scene(true, 0.5f, 30.0f, 7), 3);
+  const StageRun &single = runs.single, &pooled = runs.pooled;
   EXPECT_EQ(single.result.folds, 1) << single.result.report;
   EXPECT_EQ(pooled.result.folds, 3) << pooled.result.report;
   for (const StageRun *r : {&single, &pooled}) {

@@ -51,8 +51,8 @@ struct Context {
   // at once): lobe_sums_at then writes only the entries it computes (one pool per context).
   std::vector<std::vector<Lobe>> *lobe_buffers = nullptr;
 
-  // Per raster index (Entry::raster is 16 bits): 1 when it is held out (this context's fold of heldout_folds.h,
-  // raster), filled by fit_materials; a table, not a division per sample in the loops.
+  // Per raster index (Entry::raster is 16 bits): 1 when it is held out in this context's fold
+  // (heldout_folds.h), filled by fit_materials; a table, not a division per sample in the loops.
   const std::vector<uint8_t> *held_raster = nullptr;
 
   bool in_set(const Entry &e, int set) const {
