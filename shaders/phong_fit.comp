@@ -20,11 +20,12 @@
 // and the neighbour fill (fit_status 3) run on the CPU after either back end (core/fit/pipeline.cpp).
 layout(local_size_x = 64) in;
 
-struct Sample {  // core/samples/samples.h Sample, 24 bytes
+struct Sample {  // core/samples/samples.h Sample, 28 bytes
   float r, g, b;
   float d;             // N.L
   float s;             // the lobe's cosine: R.E or N.H (samples/lobe.h)
   uint raster_flags;   // raster | flags << 16 | resolution << 26
+  float footprint;     // the normal variance over the photo's pixel footprint (samples/footprint.h)
 };
 
 struct Fit {  // core/fit/phong_fit.h VertexFit, 40 bytes
@@ -56,6 +57,7 @@ struct Obs {
   vec3 p;      // pixel value / g_pixel_scale
   float d, s;  // min(N.L, 1), the lobe's cosine
   float w;     // N.L * resolution weight / g_weight_scale, times g_high_scale for highlight samples
+  float v;     // Sample::footprint for the GGX lobe (0 for the power forms)
   bool high;
 };
 
@@ -87,22 +89,29 @@ float ln_s(float s) {
          (1.0 + u2 * (1.0 / 3.0 + u2 * (1.0 / 5.0 + u2 * (1.0 / 7.0 + u2 * (1.0 / 9.0 + u2 * (1.0 / 11.0 + u2 / 13.0))))));
 }
 
-// GGX's D(N.H)/D(1) with a^2 = 2 / (alpha + 2) (samples/lobe.h lobe_value), for s in (0, 1].
-float ggx_lobe(float s, float alpha) {
-  const float a2 = 2.0 / (alpha + 2.0), r = a2 / (a2 + (1.0 - s * s) * (1.0 - a2));
-  return r * r;
+// GGX's D(N.H)/D(1) with a^2 = 2 / (alpha + 2), seen through a pixel footprint of normal variance
+// v (samples/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, 0.18), 1), the value
+// (a^2 / a_f^2) r^2), for s in (0, 1].
+float ggx_lobe(float s, float alpha, float v) {
+  const float a2 = 2.0 / (alpha + 2.0), a2f = min(a2 + min(max(v, 0.0), 0.18), 1.0);
+  const float den = a2f + (1.0 - s * s) * (1.0 - a2f);
+  return a2 * a2f / (den * den);
 }
 
-// Its derivative in t = ln(alpha) (lobe.h lobe_dvalue_dlog_alpha), for s in (0, 1).
-float ggx_lobe_dt(float s, float alpha) {
-  const float a2 = 2.0 / (alpha + 2.0), u = 1.0 - s * s, den = a2 + u * (1.0 - a2), r = a2 / den;
-  return 2.0 * r * u / (den * den) * (-2.0 * alpha / ((alpha + 2.0) * (alpha + 2.0)));
+// Its derivative in t = ln(alpha) (lobe.h lobe_dvalue_dlog_alpha), for s in (0, 1], or s = 1 with v > 0.
+float ggx_lobe_dt(float s, float alpha, float v) {
+  const float a2 = 2.0 / (alpha + 2.0), u = 1.0 - s * s, a2f = a2 + min(max(v, 0.0), 0.18);
+  const float da2_dt = -2.0 * alpha / ((alpha + 2.0) * (alpha + 2.0));
+  if (a2f >= 1.0) return da2_dt;
+  const float den = a2f + u * (1.0 - a2f), r = a2f / den;
+  return (r * r * (a2f - a2) / (a2f * a2f) + a2 / a2f * 2.0 * r * u / (den * den)) * da2_dt;
 }
 
-// The lobe g(s, alpha) without ln(0), overflow or denormals (as the reference's lobe()).
-float lobe(float s, float alpha) {
+// The lobe g(s, alpha) without ln(0), overflow or denormals (as the reference's lobe()); v: the
+// sample's footprint variance (GGX only).
+float lobe(float s, float alpha, float v) {
   if (!(s > 0.0)) return 0.0;
-  if (u_ggx_lobe != 0) return ggx_lobe(min(s, 1.0), alpha);
+  if (u_ggx_lobe != 0) return ggx_lobe(min(s, 1.0), alpha, v);
   return exp(max(alpha * ln_s(min(s, 1.0)), -80.0));
 }
 
@@ -110,7 +119,7 @@ float lobe(float s, float alpha) {
 // plus a finite N.L (the reference takes +Inf, which is not evidence either).
 bool load(uint i, out Obs x) {
   const Sample raw = samples[i - u_sample_base];
-  x.p = vec3(0.0); x.d = 0.0; x.s = 0.0; x.w = 0.0; x.high = false;
+  x.p = vec3(0.0); x.d = 0.0; x.s = 0.0; x.w = 0.0; x.v = 0.0; x.high = false;
   const uint flags = (raw.raster_flags >> 16) & 0x3FFu;
   const float resolution = exp2(-float(raw.raster_flags >> 26) / 8.0);  // resolution_weight()
   if ((flags & kUnusable) != 0u) return false;
@@ -123,6 +132,7 @@ bool load(uint i, out Obs x) {
   x.p = vec3(raw.r, raw.g, raw.b) * g_inv_pixel_scale;
   x.d = min(raw.d, 1.0);
   x.s = raw.s;
+  x.v = u_ggx_lobe != 0 && finite(raw.footprint) ? raw.footprint : 0.0;
   x.w = raw.d * resolution * g_inv_weight_scale * (x.high ? g_high_scale : 1.0);
   return true;
 }
@@ -226,7 +236,7 @@ float schur_by_squares(float alpha, float beta) {
   for (uint i = g_begin; i < g_end; ++i) {
     Obs x;
     if (!load(i, x)) continue;
-    const float e = lobe(x.s, alpha) - beta * x.d;
+    const float e = lobe(x.s, alpha, x.v) - beta * x.d;
     sum += x.w * e * e;
   }
   return sum + beta * beta * g_prior;
@@ -243,11 +253,11 @@ void objective(inout Linear L, float alpha) {
     const bool lobed = L.ks > 0.0 && x.s > 0.0;
     const bool ggx = u_ggx_lobe != 0;
     const float lx = lobed && !ggx ? ln_s(min(x.s, 1.0)) : 0.0;
-    const float g = lobed ? (ggx ? ggx_lobe(min(x.s, 1.0), alpha) : exp(max(alpha * lx, -80.0))) : 0.0;
+    const float g = lobed ? (ggx ? ggx_lobe(min(x.s, 1.0), alpha, x.v) : exp(max(alpha * lx, -80.0))) : 0.0;
     const vec3 r = x.p - L.rho * x.d - vec3(L.ks * g);
     kahan_add(e, comp, x.w * dot(r, r));
-    if (lobed && x.s < 1.0) {  // ln s finite and non-zero
-      const float dg = L.ks * (ggx ? ggx_lobe_dt(x.s, alpha) : g * lx * alpha);  // d(k_s g)/dt
+    if (lobed && (x.s < 1.0 || (ggx && x.v > 0.0))) {  // ln s finite and non-zero, or a footprint's peak
+      const float dg = L.ks * (ggx ? ggx_lobe_dt(min(x.s, 1.0), alpha, x.v) : g * lx * alpha);  // d(k_s g)/dt
       grad += -2.0 * x.w * (r.r + r.g + r.b) * dg;
       curv += 6.0 * x.w * dg * dg;
     }
@@ -267,7 +277,7 @@ Linear solve(float alpha, bool ks_free) {
     for (uint i = g_begin; i < g_end; ++i) {
       Obs x;
       if (!load(i, x)) continue;
-      const float g = lobe(x.s, alpha), wg = x.w * g;
+      const float g = lobe(x.s, alpha, x.v), wg = x.w * g;
       b += wg * x.d;
       g2 += wg * g;
       qr += wg * (x.p - g_r * x.d);
@@ -308,9 +318,9 @@ Linear solve(float alpha, bool ks_free) {
 // Output.
 
 // evaluate_phong() of the reference, in pixel units.
-vec3 evaluate(Fit f, float d, float s) {
+vec3 evaluate(Fit f, float d, float s, float v) {
   d = max(d, 0.0);
-  const float spec = (d > 0.0 && f.ks > 0.0) ? f.ks * lobe(s, f.shininess) : 0.0;
+  const float spec = (d > 0.0 && f.ks > 0.0) ? f.ks * lobe(s, f.shininess, v) : 0.0;
   return f.kd * d * vec3(f.color[0], f.color[1], f.color[2]) + vec3(spec);
 }
 
@@ -322,7 +332,7 @@ void quality_metrics(inout Fit f) {
   for (uint i = g_begin; i < g_end; ++i) {
     Obs x;
     if (!load(i, x)) continue;
-    const vec3 diff = x.p - evaluate(f, x.d, x.s) * g_inv_pixel_scale;
+    const vec3 diff = x.p - evaluate(f, x.d, x.s, x.v) * g_inv_pixel_scale;
     const float err2 = dot(diff, diff);  // scaled; * p2 in pixel units (may be +Inf: clamped below)
     e += x.w * err2, w += x.w;
     const float s_re = u_half_angle_lobe != 0 ? (x.s > 0.0 ? 2.0 * x.s * x.s - 1.0 : -1.0) : x.s;

@@ -6,7 +6,10 @@
 //
 // Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
 //   f = rho d + k_s g(s, alpha),  rho = k_d C,  unit irradiance; g = max(s, 0)^alpha, or GGX's
-//      D(N.H)/D(1) with a^2 = 2 / (alpha + 2) when u_ggx_lobe != 0 (samples/lobe.h lobe_value)
+//      D(N.H)/D(1) with a^2 = 2 / (alpha + 2) when u_ggx_lobe != 0 (samples/lobe.h lobe_value),
+//      seen through the pixel's footprint: the normal's variance over one box pixel from the
+//      fragment's derivatives (pixel_footprint_variance; samples/footprint.h takes the same from
+//      the mesh for a photo's pixel resampled at a vertex), ggx_lobe_through_footprint
 //   d: the diffuse factor, N.L (Lambert) or N.L T(max(N.L, 0.2)) T(max(N.E, 0.2)) / T(1)^2 (coated), per
 //      vertex (`coated` 1 or 0, DiffuseForms; blended linearly across a triangle that has both);
 //   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
@@ -52,22 +55,34 @@ float lobe_cosine(vec3 n, vec3 l, vec3 e) {
   return dot(2.0 * dot(n, l) * n - l, e);
 }
 
+// The variance of the unit shading normal n over this fragment's pixel (a box: 1/12 pixel^2 per
+// axis) from its screen-space derivatives (samples/footprint.h). Call it in uniform control flow
+// (before any early return): derivatives are undefined elsewhere.
+float pixel_footprint_variance(vec3 n) {
+  vec3 dx = dFdx(n), dy = dFdy(n);
+  float v = (dot(dx, dx) + dot(dy, dy)) / 12.0;
+  return v >= 0.0 ? v : 0.0;  // NaN from a degenerate normal: no footprint
+}
+
 // k_s g(s, alpha) for s > 0: s^alpha with the exponent's logarithm floored at -80 (no denormals,
-// no NaN), or the GGX lobe (a positive denominator for alpha >= 0).
-float phong_specular(float ks, float alpha, float s) {
+// no NaN), or the GGX lobe (a positive denominator for alpha >= 0) seen through a footprint of
+// normal variance v (samples/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, 0.18), 1)).
+float phong_specular(float ks, float alpha, float s, float v) {
   if (!(ks > 0.0) || !(s > 0.0)) return 0.0;
   float c = min(s, 1.0);
   if (u_ggx_lobe != 0) {
     float a2 = 2.0 / (max(alpha, 0.0) + 2.0);
-    float r = a2 / (a2 + (1.0 - c * c) * (1.0 - a2));
-    return ks * r * r;
+    float a2f = min(a2 + min(max(v, 0.0), 0.18), 1.0);
+    float r = a2f / (a2f + (1.0 - c * c) * (1.0 - a2f));
+    return ks * (a2 / a2f) * r * r;
   }
   return ks * exp(max(alpha * log(c), -80.0));
 }
 
-// The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value.
-void phong_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, vec3 l, vec3 e, out vec3 diffuse,
+// The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value; v: the
+// pixel's footprint variance (pixel_footprint_variance).
+void phong_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, vec3 l, vec3 e, float v, out vec3 diffuse,
                  out float specular) {
   diffuse = rho * diffuse_factor(dot(n, l), dot(n, e), coated);
-  specular = phong_specular(ks, alpha, lobe_cosine(n, l, e));
+  specular = phong_specular(ks, alpha, lobe_cosine(n, l, e), v);
 }

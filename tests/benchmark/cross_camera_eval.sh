@@ -10,7 +10,8 @@
 #   (b) over those that every fit models ("common": fit_status != 0 in each), the protocol.
 #   tests/benchmark/cross_camera_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_fit OPTIONS...]
 #   environment: VBRDF_SHARED_DIR (default <repo>/../shared), CAMERAS (default "spot_dir24 spot_dir24_view2"),
-#   SETS (default "all common": the vertex sets scored),
+#   SETS (default "all common": the vertex sets scored), VBRDF_EVAL_OPTIONS (extra vbrdf_eval options,
+#   e.g. "--footprint off" for fits made with --footprint off),
 #   CHECK_TOLERANCE (e.g. 0.05): only the "common" rows of each camera's own fit and of "both" at
 #   that camera are scored, and the script fails (exit 1) when "both" is worse than the camera's
 #   own fit by more than that fraction (whole-surface mean): adding a camera's photos must not
@@ -100,7 +101,7 @@ for f in $cameras both; do
       log=$work/eval_${f}_at_${c}_$set.log
       "$eval_tool" --result "$work/$f/fit.ply" --project "$s/heldout/project.mlp" --photo-dir "$s/heldout/linear" \
           --training "$s/project.mlp" --training-photo-dir "$s/linear" --gt-visible "$gt" --gt-lit "$work/$c/gt_lit.txt" \
-          > "$log" 2>&1
+          ${VBRDF_EVAL_OPTIONS:-} > "$log" 2>&1
       whole=$(grep "whole surface: product" "$log" | awk '{print $(NF-2) " / " $NF}')
       clean=$(grep "clean pixels, modelled vertices only" "$log" | awk '{print $(NF-2) " / " $NF}')
       rbf=$(grep "same samples: RBF" "$log" | awk '{print $(NF-2) " / " $NF}')

@@ -28,6 +28,8 @@
 // --samples-csv FILE: every scored sample (vertex, held-out photo, fit_status, mixed footprint, diffuse
 //   factor, observed and predicted linear RGB, CIEDE2000 of the product, PTM and RBF: -1 where not
 //   scored), to locate the error (e.g. tests/tools/error_map.py).
+// --footprint on|off: predict the GGX lobe through each held-out photo's pixel footprint
+//   (samples/footprint.h; on, as the fit does) or at the vertex alone (a fit made with it off).
 // --gt-visible: score only vertices whose uchar `visible` property (ground-truth PLY, same vertex
 //   order as the result) is non-zero.
 // --max-mean-de / --max-p95-de: bounds on the whole-surface product figure.
@@ -139,6 +141,7 @@ int main(int argc, char **argv) {
   double max_mean = -1, max_p95 = -1, max_clean_mean = -1, max_clean_p95 = -1;
   float dome_radius = 0, light_unit_scale = 0;
   bool below_baselines = false;
+  bool footprint = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--below-baselines") {
@@ -164,6 +167,7 @@ int main(int argc, char **argv) {
     else if (a == "--gt-lit") gt_lit_path = v;
     else if (a == "--samples-csv") samples_csv = v;
     else if (a == "--predict") predict = v;
+    else if (a == "--footprint") footprint = v == "on";
     else if (a == "--max-mean-de") max_mean = std::stod(v);
     else if (a == "--max-p95-de") max_p95 = std::stod(v);
     else if (a == "--max-clean-mean-de") max_clean_mean = std::stod(v);
@@ -178,7 +182,7 @@ int main(int argc, char **argv) {
                  "                  [--dome-radius R] [--light-unit-scale S]\n"
                  "                  [--visibility gl|cpu] [--training train.mlp [--training-lp F]\n"
                  "                  [--training-photo-dir D]] [--gt-visible gt_vertex.ply] [--gt-lit lit.txt]\n"
-                 "                  [--predict render|vertex]\n"
+                 "                  [--predict render|vertex] [--footprint on|off]\n"
                  "                  [--max-mean-de X] [--max-p95-de Y] [--max-clean-mean-de X] [--max-clean-p95-de Y]\n"
                  "                  [--below-baselines (needs --training)]\n";
     return 2;
@@ -196,6 +200,7 @@ int main(int argc, char **argv) {
     RelightOptions options;
     options.gather.lobe = lobe;  // the samples' lobe cosine in the form the fit used
     options.gather.diffuse = diffuse;  // and their diffuse factor
+    options.gather.footprint = footprint;
     if (!train_mlp.empty()) {
       training = load_photos(train_mlp, train_lp, train_photo_dir, placement);
       options.training_rasters = &training.project.rasters;

@@ -5,6 +5,7 @@
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
 //             [--photo-shadows on|off]
 //             [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
+//             [--footprint on|off]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -34,7 +35,8 @@ int usage() {
                "                 [--materials on|off] [--max-materials N] [--material-lobes-everywhere] [--no-robust-colour]\n"
                "                 [--min-heldout-photos N]\n"
                "                 [--photo-shadows on|off]\n"
-               "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n";
+               "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n"
+               "                 [--footprint on|off]\n";
   return 2;
 }
 } // namespace
@@ -71,6 +73,7 @@ int main(int argc, char **argv) {
       else if (v == "coated") settings.diffuse_choice = DiffuseTermChoice::Coated;
       else return usage();
     } else if (a == "--resolution-weights") settings.gather.resolution_weights = next() == "on";
+    else if (a == "--footprint") settings.gather.footprint = next() == "on";
     else if (a == "--material-lobes-everywhere") settings.material_options.keep_full_fits = false;
     else if (a == "--no-robust-colour") settings.material_options.robust_colour = false;
     else if (a == "--max-materials") settings.material_options.max_materials = std::stoi(next());

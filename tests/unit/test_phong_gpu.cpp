@@ -345,6 +345,31 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
   EXPECT_GT(differ, int(chunk.vertex_count) / 8);
 }
 
+// The GGX lobe seen through each sample's pixel footprint (Sample::footprint, lobe.h), footprints
+// from none to past the clamp, in both back ends alike; and the footprint matters to the fits.
+TEST_F(PhongFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(0, 1);
+  SampleChunk chunk;
+  for (int v = 0; v < 4000; ++v) {
+    std::vector<Sample> s = random_vertex(rng);
+    const float scale = v % 4 == 0 ? 0.0f : v % 4 == 1 ? 1e-3f : v % 4 == 2 ? 0.02f : 0.3f;
+    for (Sample &x : s) x.footprint = scale * u(rng);
+    append_vertex(chunk, s);
+  }
+  PhongFitOptions ggx;
+  ggx.lobe = LobeForm::GgxNH;
+  const Agreement a = agree(chunk, ggx, "GGX lobe through pixel footprints");
+  EXPECT_GT(a.well, 1000);
+  EXPECT_LE(a.well_disagree, a.well / 200);
+  SampleChunk plain = chunk;
+  for (Sample &x : plain.samples) x.footprint = 0;
+  const std::vector<VertexFit> through = run_cpu(chunk, ggx), at_vertex = run_cpu(plain, ggx);
+  int differ = 0;
+  for (uint32_t v = 0; v < chunk.vertex_count; ++v) differ += v % 4 != 0 && parameter_difference(through[v], at_vertex[v]) > 1e-3;
+  EXPECT_GT(differ, int(chunk.vertex_count) / 4);
+}
+
 TEST_F(PhongFitGpuTest, TwoHundredFiftySixPhotoVertices) {
   std::mt19937 rng(9);
   SampleChunk chunk;

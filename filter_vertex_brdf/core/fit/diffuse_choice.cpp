@@ -90,7 +90,7 @@ std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Rast
           for (const Sample *s = begin; s != end; ++s) {
             if (!held_out_in_fold(s->raster, k) || !scorable(*s)) continue;
             float predicted[3];
-            evaluate_phong(fit, s->d, s->lobe_cos, phong.lobe, predicted);
+            evaluate_phong(fit, s->d, s->lobe_cos, phong.lobe, predicted, s->footprint);
             for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;
             ++p.samples;
           }

@@ -60,7 +60,8 @@ void grid_energies(const Context &c, int set, const std::vector<Static> &S, cons
         if (ls > 0 || !c.in_set(e, set)) continue;
         if (c.ggx) {
           const double u = -double(ls);
-          for (size_t i = r.first; i <= r.last; ++i) g[i] = ggx_lobe_of_u_a2(u, a2[i]);
+          const double vc = clamped_footprint(e.v);
+          for (size_t i = r.first; i <= r.last; ++i) g[i] = ggx_lobe_through_clamped_footprint(u, a2[i], vc);
         } else {  // the squaring chain from the grid's start (cheap), so the window's values are the full grid's
           for (size_t i = 0; i <= r.last; ++i)
             g[i] = squared[i] ? square_lobe(g[i - kGridStepsPerDoubling]) : lobe_of(ls, grid[i], false);

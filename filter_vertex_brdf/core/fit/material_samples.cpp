@@ -23,7 +23,8 @@ bool grazing_sample(const Sample &s) {
          std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]) && std::isfinite(s.lobe_cos);
 }
 MaterialSampleStore::Entry entry_of(const Sample &s, float w) {
-  return {{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.d, 1.0f), s.lobe_cos, w, s.raster, uint16_t(s.flags | s.resolution << 10)};
+  return {{s.rgb[0], s.rgb[1], s.rgb[2]}, std::min(s.d, 1.0f), s.lobe_cos, w, s.raster, uint16_t(s.flags | s.resolution << 10),
+          s.footprint};
 }
 } // namespace
 

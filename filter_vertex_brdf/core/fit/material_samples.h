@@ -23,6 +23,7 @@ public:
     float d, s, w;      // N.L, the lobe's cosine (R.E or N.H), weight (resolution weight included)
     uint16_t raster;
     uint16_t flags;     // SampleFlag bits of the sample | its Sample::resolution << 10
+    float v;            // Sample::footprint (the GGX lobe through the photo's pixel footprint)
   };
   size_t vertex_count() const { return begin_.size(); }
   uint64_t first(size_t v) const { return begin_[v]; }  // index range [first, last) into entries()

@@ -78,12 +78,13 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
       if ((!f && !sc) || key > 0) continue;
       if (c.ggx) {
         const double u = -double(key);
-        for (int k = k_first; k <= k_last; ++k) g_of[k] = ggx_lobe_of_u_a2(u, a2[k]);
+        const double vc = clamped_footprint(e.v);
+        for (int k = k_first; k <= k_last; ++k) g_of[k] = ggx_lobe_through_clamped_footprint(u, a2[k], vc);
       } else if (doubling && !centre_only) {  // 4 exponentials, the rest by squaring: s^(2 alpha) = (s^alpha)^2
-        for (int k = 0; k < 4; ++k) g_of[k] = lobe[k](key);
+        for (int k = 0; k < 4; ++k) g_of[k] = lobe[k](key, e.v);
         for (int k = 4; k < kAlphaSteps; ++k) g_of[k] = square_lobe(g_of[k - 4]);
       } else {
-        for (int k = k_first; k <= k_last; ++k) g_of[k] = lobe[k](key);
+        for (int k = k_first; k <= k_last; ++k) g_of[k] = lobe[k](key, e.v);
       }
       if (f) add_to_lobes(fit_sums, kAlphaSteps, e, g_of, size_t(k_first), size_t(k_last));
       if (sc && !same_sets) add_to_lobes(score_sums, kAlphaSteps, e, g_of, size_t(k_first), size_t(k_last));
@@ -160,7 +161,7 @@ void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[
   std::vector<double> res;
   for (uint64_t i = c.store.first(v); i < c.store.last(v); ++i) {
     const Entry &e = E[i];
-    const double g = ks > 0 ? ks * lobe((*c.lobe_keys)[i]) : 0.0;
+    const double g = ks > 0 ? ks * lobe((*c.lobe_keys)[i], e.v) : 0.0;
     double r = 0;
     for (int ch = 0; ch < 3; ++ch) r += std::fabs(e.rgb[ch] - rho[ch] * e.d - g);
     res.push_back(r / 3);
@@ -176,7 +177,7 @@ void robust_rho(const Context &c, size_t v, double ks, double alpha, double rho[
   for (uint64_t i = c.store.first(v), j = 0; i < c.store.last(v); ++i, ++j) {
     if (std::fabs(res[j] - med) > 3 * mad) continue;
     const Entry &e = E[i];
-    const double g = ks > 0 ? ks * lobe((*c.lobe_keys)[i]) : 0.0;
+    const double g = ks > 0 ? ks * lobe((*c.lobe_keys)[i], e.v) : 0.0;
     a += double(e.w) * e.d * e.d;
     for (int ch = 0; ch < 3; ++ch) p[ch] += double(e.w) * e.d * (e.rgb[ch] - g);
     ++kept;
@@ -223,7 +224,7 @@ std::vector<GivingTest> test_giving(const Context &sel, const std::vector<Static
     double with_sum = 0, without_sum = 0;
     auto score = [&](const Entry &e, float key) {
       if (!sel.in_set(e, kHeld)) return;
-      const double gk = lobe(key);
+      const double gk = lobe(key, e.v);
       float with[3], without[3];
       for (int ch = 0; ch < 3; ++ch) {
         with[ch] = float(P.rho[3 * v + size_t(ch)] * e.d + P.ks[v] * gk);

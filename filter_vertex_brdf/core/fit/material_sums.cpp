@@ -46,7 +46,7 @@ const std::vector<std::vector<Lobe>> &lobe_sums_at(const Context &c, int set, co
         if (!c.in_set(e, set)) continue;
         const float key = (*c.lobe_keys)[k];
         for (size_t j = 0; j < count; ++j) {
-          const double g = lobe[j](key);
+          const double g = lobe[j](key, e.v);
           if (g != 0) add_to_lobe(sums[j], e, g);
         }
       }

@@ -76,13 +76,14 @@ struct LobeAt {
   bool ggx = false;
   LobeAt() = default;
   LobeAt(double alpha_, bool ggx_) : alpha(alpha_), a2(ggx_a2(alpha_)), ggx(ggx_) {}
-  double operator()(float key) const {
+  // footprint: the entry's v (Entry::v), GGX only (lobe.h ggx_lobe_through_footprint).
+  double operator()(float key, float footprint) const {
     if (key > 0) return 0;
-    if (ggx) return ggx_lobe_of_u_a2(-double(key), a2);
+    if (ggx) return ggx_lobe_through_footprint(-double(key), a2, footprint);
     return std::exp(std::max(alpha * double(key), -80.0));
   }
 };
-inline double lobe_of(float key, double alpha, bool ggx) { return LobeAt(alpha, ggx)(key); }
+inline double lobe_of(float key, double alpha, bool ggx) { return LobeAt(alpha, ggx)(key, 0.0f); }
 
 // (s^alpha)^2 = s^(2 alpha), as 0 below lobe_of's floor exp(-80): repeated squaring would otherwise
 // walk through denormals (slow, and meaningless as a weight).

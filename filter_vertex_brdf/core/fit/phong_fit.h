@@ -119,7 +119,9 @@ void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOp
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
 // d: the diffuse factor (Sample::d: N.L for Lambert, diffuse_factor() in general); lobe_cos and
 // form: the lobe's cosine (Sample::lobe_cos) and the form the fit used (PhongFitOptions::lobe).
-void evaluate_phong(const VertexFit &fit, float d, float lobe_cos, LobeForm form, float out_rgb[3]);
+// footprint: the sample's Sample::footprint (the lobe seen through the photo's pixel footprint).
+void evaluate_phong(const VertexFit &fit, float d, float lobe_cos, LobeForm form, float out_rgb[3],
+                    float footprint = 0);
 
 // True when the vertex has a reflectance model (any status but kFitNone).
 inline bool has_model(const VertexFit &fit) { return fit.status != kFitNone; }

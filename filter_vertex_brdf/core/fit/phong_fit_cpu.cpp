@@ -13,17 +13,22 @@ struct FitSample {
   double d, s, w;
   bool highlight;
   double ln_s = 0;  // ln(min(s, 1)) where s > 0 (with_ln_s): the lobe's iterations need no log
+  double v = 0;     // Sample::footprint: the GGX lobe is seen through it (lobe.h), clamped (with_ln_s)
+  double u = 1;     // 1 - min(s, 1)^2 where s > 0 (with_ln_s): GGX's variable
 };
 
-// The lobe g(s, alpha) of the form for a fit sample (samples/lobe.h lobe_value); power forms from
-// its stored logarithm (bit for bit lobe_value's).
-inline double lobe(LobeForm form, const FitSample &x, double alpha) {
-  if (!lobe_is_power(form)) return lobe_value(form, x.s, alpha);
-  return x.s > 0 ? std::exp(std::max(alpha * x.ln_s, -80.0)) : 0.0;
+// The lobe g(s, alpha) of the form for a fit sample (samples/lobe.h lobe_value, the same values up
+// to rounding); power forms from its stored logarithm (bit for bit lobe_value's); `a2`: ggx_a2(alpha),
+// once per alpha for the many samples of a vertex.
+inline double lobe(LobeForm form, const FitSample &x, double alpha, double a2) {
+  if (!(x.s > 0)) return 0.0;
+  if (!lobe_is_power(form)) return ggx_lobe_through_clamped_footprint(x.u, a2, x.v);
+  return std::exp(std::max(alpha * x.ln_s, -80.0));
 }
 
 inline FitSample with_ln_s(FitSample x) {
-  if (x.s > 0) x.ln_s = std::log(std::min(x.s, 1.0));
+  if (x.s > 0) x.ln_s = std::log(std::min(x.s, 1.0)), x.u = 1 - std::min(x.s, 1.0) * std::min(x.s, 1.0);
+  x.v = clamped_footprint(x.v);
   return x;
 }
 
@@ -50,10 +55,11 @@ public:
   Linear solve(double alpha, bool ks_free, const PhongFitOptions &o) const {
     double b = 0, g2 = 0, q[3] = {0, 0, 0};
     lobes_.resize(samples_.size());  // kept for the energy below: one exponential per sample
+    const double a2 = ggx_a2(alpha);
     if (ks_free)
       for (size_t i = 0; i < samples_.size(); ++i) {
         const FitSample &x = samples_[i];
-        const double g = lobes_[i] = lobe(form_, x, alpha);
+        const double g = lobes_[i] = lobe(form_, x, alpha, a2);
         b += x.w * x.d * g;
         g2 += x.w * g * g;
         for (int c = 0; c < 3; ++c) q[c] += x.w * g * x.p[c];
@@ -103,11 +109,12 @@ public:
   // parameters (envelope theorem: the linear parameters are optimal).
   void derivatives(const Linear &L, double alpha, double &grad, double &curv) const {
     grad = curv = 0;
+    const double a2 = ggx_a2(alpha);
     for (const FitSample &x : samples_) {
-      if (!(x.s > 0) || x.s >= 1) continue;
-      const double g = lobe(form_, x, alpha);
+      if (!(x.s > 0) || (x.s >= 1 && !(x.v > 0))) continue;
+      const double g = lobe(form_, x, alpha, a2);
       const double dg = L.ks * (lobe_is_power(form_) ? g * x.ln_s * alpha  // d(k_s g)/dt
-                                                     : lobe_dvalue_dlog_alpha(form_, x.s, alpha));
+                                                     : lobe_dvalue_dlog_alpha(form_, x.s, alpha, x.v));
       for (int c = 0; c < 3; ++c) {
         const double r = x.p[c] - L.rho[c] * x.d - L.ks * g;
         grad += -2 * x.w * r * dg;
@@ -162,7 +169,7 @@ void quality_metrics(const std::vector<FitSample> &samples, const VertexFit &fit
   int nd = 0, ns = 0;
   for (const FitSample &x : samples) {
     float f[3];
-    evaluate_phong(fit, float(x.d), float(x.s), form, f);
+    evaluate_phong(fit, float(x.d), float(x.s), form, f, float(x.v));
     double err2 = 0;
     for (int c = 0; c < 3; ++c) err2 += (x.p[c] - f[c]) * (x.p[c] - f[c]);
     e += x.w * err2, w += x.w;
@@ -192,9 +199,10 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 
 } // namespace
 
-void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out[3]) {
+void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out[3], float footprint) {
   const float d = std::max(d_in, 0.0f);
-  const float spec = (d > 0 && fit.ks > 0) ? fit.ks * float(lobe_value(form, lobe_cos, fit.shininess)) : 0.0f;
+  const float spec =
+      (d > 0 && fit.ks > 0) ? fit.ks * float(lobe_value(form, lobe_cos, fit.shininess, footprint)) : 0.0f;
   for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
 }
 
@@ -223,6 +231,7 @@ int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std
                 s.lobe_cos > lobe_threshold(o.lobe, o.specular_threshold)};
     (x.highlight ? w_high : w_other) += x.w;
     n_high += x.highlight;
+    x.v = s.footprint;
     samples.push_back(with_ln_s(x));
   }
   return n_high;

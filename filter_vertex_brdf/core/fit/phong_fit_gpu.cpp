@@ -23,7 +23,7 @@ namespace vbrdf {
 // fields pack into one uint as raster | flags << 16 | resolution << 26 (bit-fields: the word's layout
 // is checked by tests/unit/test_samples.cpp SampleWordMatchesTheShader) and iterations | status << 16
 // | converged << 24).
-static_assert(sizeof(Sample) == 24 && offsetof(Sample, raster) == 20, "Sample layout must match shaders/phong_fit.comp");
+static_assert(sizeof(Sample) == 28 && offsetof(Sample, raster) == 20 && offsetof(Sample, footprint) == 24, "Sample layout must match shaders/phong_fit.comp");
 static_assert(sizeof(VertexFit) == 40 && offsetof(VertexFit, kd) == 12 && offsetof(VertexFit, rmse) == 32 &&
                   offsetof(VertexFit, iterations) == 36 && offsetof(VertexFit, status) == 38 &&
                   offsetof(VertexFit, converged) == 39,

@@ -19,6 +19,7 @@
 #include "inputs/light_source.h"
 #include "inputs/photo_prefetch.h"
 #include "fit/diffuse_choice.h"
+#include "samples/footprint.h"
 #include "io/fit_outputs.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
@@ -229,6 +230,9 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   FitSettings settings = settings_in;
   settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
   settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
+  if (settings.fit_reflectance && settings.gather.footprint && settings.gather.lobe == LobeForm::GgxNH)
+    settings.gather.normal_gradients =  // once for the pilot's and the fit's gathers (footprint.h)
+        std::make_shared<const std::vector<float>>(normal_gradients(input.mesh));
   if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
   const MeshView &mesh = input.mesh;
   FitResult result;

@@ -173,7 +173,12 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
     rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
         << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
         << "); diffuse term: " << r.diffuse_choice_note << " (per-vertex diffuse_form: 0 lambert, 1 coated)"
-        << "; samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off") << "\n";
+        << "; samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off")
+        << (settings.phong.lobe != LobeForm::GgxNH ? std::string()
+            : settings.gather.footprint ? std::string("; the lobe seen through each photo's pixel footprint (shininess is "
+                                                      "the surface's own; a renderer filters it per pixel)")
+                                        : std::string("; the lobe at the vertex alone (no pixel footprint)"))
+        << "\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"

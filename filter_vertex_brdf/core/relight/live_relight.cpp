@@ -76,6 +76,7 @@ vec3 srgb(vec3 c) {
 void main() {
   float len = length(v_normal);
   vec3 n = len > 0.0 ? v_normal / len : v_normal;
+  float footprint = pixel_footprint_variance(n);
   vec3 l = u_light_dir;
   float d = dot(n, l);
   vec3 c;
@@ -93,7 +94,7 @@ void main() {
   vec3 e = u_eye_is_point != 0 ? normalize(u_eye - v_position) : u_eye;
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, diffuse, spec);
+  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
   c = u_display == 1 ? diffuse : u_display == 2 ? vec3(spec) : diffuse + vec3(spec);
   c *= u_exposure;
   o_color = vec4(u_encode_srgb != 0 ? srgb(c) : c, 1.0);

@@ -94,6 +94,7 @@ void main() {
   if (v_rho_fitted.a < 0.999) { o_color = vec4(0.0, 0.0, 0.0, 3.0); return; }
   float len = length(v_normal);
   vec3 n = len > 0.0 ? v_normal / len : v_normal;
+  float footprint = pixel_footprint_variance(n);
   // Light direction and irradiance at the fragment (light_source.h): a point light's change
   // across the object, with the distance clamped as on the CPU.
   vec3 l = u_light_dir;
@@ -118,7 +119,7 @@ void main() {
   vec3 e = normalize(u_eye - v_position);
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, diffuse, spec);
+  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
   o_color = vec4((diffuse + vec3(spec)) * irradiance, 1.0);
 }
 )";

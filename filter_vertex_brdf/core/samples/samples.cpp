@@ -7,6 +7,7 @@
 
 #include "base/errors.h"
 #include "base/vec3.h"
+#include "samples/footprint.h"
 
 namespace vbrdf {
 
@@ -260,7 +261,8 @@ namespace {
 void finish_vertex_samples(std::vector<Sample> &samples, const std::vector<uint32_t> &slot_begin,
                            std::vector<uint32_t> &kept, const std::vector<Raster> &rasters, const MeshView &mesh,
                            size_t first, const std::vector<uint32_t> &active, bool resolution_weights,
-                           GatherStats &stats) {
+                           const std::vector<float> &gradients, const std::vector<FootprintCamera> &cameras,
+                           const std::vector<uint32_t> &camera_of, GatherStats &stats) {
 #pragma omp parallel
   {
     uint64_t flag_counts[16] = {};
@@ -277,9 +279,17 @@ void finish_vertex_samples(std::vector<Sample> &samples, const std::vector<uint3
         for (const Sample *s = begin; s != last; ++s)
           best = std::max(best, resolution[s->raster] = photo_resolution(rasters[s->raster], mesh.positions + 3 * v,
                                                                            mesh.normals + 3 * v));
+      uint32_t footprint_camera_index = UINT32_MAX;  // the photos of one camera share the footprint
+      float footprint = 0.0f;
       for (Sample *s = begin; s != last; ++s) {
         for (uint16_t f = s->flags; f; f &= uint16_t(f - 1)) ++flag_counts[bit_index(uint16_t(f & -f))];
         s->resolution = best > 0 ? resolution_code(resolution[s->raster] / best) : 0;
+        if (!gradients.empty() && camera_of[s->raster] != footprint_camera_index) {
+          footprint_camera_index = camera_of[s->raster];
+          footprint = footprint_variance(cameras[footprint_camera_index], mesh.positions + 3 * v, mesh.normals + 3 * v,
+                                         gradients.data() + 9 * v);
+        }
+        s->footprint = footprint;
         ++seen_vertices[s->raster];
       }
     }
@@ -309,6 +319,25 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     return settings.diffuse.at(v) == DiffuseForm::Coated ? as_coated : as_lambert;
   };
   const size_t raster_count = std::max<size_t>(rasters.size(), 1);
+  // The footprint's normal variance (footprint.h) matters to the GGX lobe only.
+  const bool footprint = settings.footprint && settings.lobe == LobeForm::GgxNH;
+  std::shared_ptr<const std::vector<float>> gradients_owned = settings.normal_gradients;
+  if (footprint && (!gradients_owned || gradients_owned->size() != 9 * mesh.vertex_count))
+    gradients_owned = std::make_shared<const std::vector<float>>(normal_gradients(mesh));
+  static const std::vector<float> kNone;
+  const std::vector<float> &gradients = footprint ? *gradients_owned : kNone;
+  // One footprint camera per distinct camera (an RTI capture: one for all photos), camera_of[raster].
+  std::vector<FootprintCamera> cameras;
+  std::vector<uint32_t> camera_of(rasters.size(), 0);
+  if (!gradients.empty())
+    for (size_t r = 0; r < rasters.size(); ++r) {
+      if (r > 0 && same_view(rasters[r], rasters[r - 1])) {
+        camera_of[r] = camera_of[r - 1];
+        continue;
+      }
+      camera_of[r] = uint32_t(cameras.size());
+      cameras.push_back(footprint_camera(rasters[r]));
+    }
   // Chunks are sized as a dense vertices x rasters block of samples would fit the budget (the
   // samples stored are at most that).
   const size_t chunk_vertices = std::max<size_t>(
@@ -367,7 +396,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     }
     std::vector<uint32_t> kept(active.size());
     finish_vertex_samples(chunk.samples, slot_begin, kept, rasters, mesh, first, active, settings.resolution_weights,
-                          stats);
+                          gradients, cameras, camera_of, stats);
     // Offsets over the chunk's vertices (no samples for those no photo sees); samples that the
     // footprint put off the photo leave gaps, closed in vertex order (rare: photo borders).
     chunk.first_vertex = uint32_t(first);

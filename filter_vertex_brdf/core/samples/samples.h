@@ -50,8 +50,11 @@ struct Sample {
   uint16_t flags : 10;      // SampleFlag bits
   uint16_t resolution : 6;  // how well this photo resolves the vertex, relative to the vertex's
                             //   best-resolving photo: weight 2^(-resolution/8) (resolution_weight)
+  float footprint = 0;      // variance of the shading normal over the photo's pixel footprint of the
+                            //   vertex (samples/footprint.h; 0 = none, or not computed): the GGX
+                            //   lobe is seen through it (lobe.h ggx_lobe_through_footprint)
 };
-static_assert(sizeof(Sample) == 24, "Sample must stay compact");
+static_assert(sizeof(Sample) == 28, "Sample must stay compact");
 
 // The fit's weight factor for a sample's photo resolution: 1 for the photos that resolve the
 // vertex best (and for every sample when all its photos see it alike, e.g. one camera), down to
@@ -104,6 +107,12 @@ struct GatherSettings {
   // code 0 (all photos alike). Off by default: on the spot pair the two-camera fit scored worse
   // with it (README "The lobe's form and several cameras").
   bool resolution_weights = false;
+  // Fill Sample::footprint (the normal variance over the photo's pixel footprint, footprint.h) for
+  // the GGX lobe; false, or another lobe form: every footprint 0 (the lobe at the vertex alone).
+  bool footprint = true;
+  // The mesh's normal_gradients (footprint.h) when the caller has them (the fit computes them once
+  // for its pilot and its gather); empty: gather_samples computes them.
+  std::shared_ptr<const std::vector<float>> normal_gradients;
 };
 
 // Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and

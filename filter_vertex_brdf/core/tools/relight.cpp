@@ -235,7 +235,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         o.d = s.d;
         r.modelled = has_model(fit);
         float predicted[3];
-        evaluate_phong(fit, s.d, s.lobe_cos, options.gather.lobe, predicted);
+        evaluate_phong(fit, s.d, s.lobe_cos, options.gather.lobe, predicted, s.footprint);
         const float irradiance = light_irradiance_at(lights[s.raster], mesh.positions + 3 * v);
         for (float &c : predicted) c *= irradiance;
         const uint8_t own = masks.own_texels(s.raster, v);
