@@ -73,8 +73,8 @@ float phong_specular(float ks, float alpha, float s, float v) {
   if (u_ggx_lobe != 0) {
     float a2 = 2.0 / (max(alpha, 0.0) + 2.0);
     float a2f = min(a2 + min(max(v, 0.0), 0.18), 1.0);
-    float r = a2f / (a2f + (1.0 - c * c) * (1.0 - a2f));
-    return ks * (a2 / a2f) * r * r;
+    float den = a2f + (1.0 - c * c) * (1.0 - a2f);
+    return ks * a2 * a2f / (den * den);  // as phong_fit.comp's ggx_lobe and lobe.h
   }
   return ks * exp(max(alpha * log(c), -80.0));
 }

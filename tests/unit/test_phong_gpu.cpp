@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -54,6 +55,18 @@ std::vector<Sample> random_vertex(std::mt19937 &rng, int n = 0) {
   if (n <= 0) n = 3 + int(u(rng) * u(rng) * 197);
   const int highlights = int(u(rng) * 0.5f * float(n) + 0.5f);
   return test::synth_samples(t, n, 0.05f * u(rng), rng, highlights);
+}
+
+// `vertices` random vertices (random_vertex), each of a vertex's samples then given to
+// `mark(vertex index, sample)` (drawing from `rng` in that order).
+SampleChunk random_chunk(std::mt19937 &rng, int vertices, const std::function<void(int, Sample &)> &mark) {
+  SampleChunk chunk;
+  for (int v = 0; v < vertices; ++v) {
+    std::vector<Sample> s = random_vertex(rng);
+    for (Sample &x : s) mark(v, x);
+    append_vertex(chunk, s);
+  }
+  return chunk;
 }
 
 // Usable and highlight-usable sample counts under the contract's rule.
@@ -320,12 +333,8 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuUnderOtherOptions) {
 TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
   std::mt19937 rng(17);
   std::uniform_int_distribution<int> code(0, 31);
-  SampleChunk chunk;
-  for (int v = 0; v < 4000; ++v) {
-    std::vector<Sample> s = random_vertex(rng);
-    for (Sample &x : s) x.resolution = uint16_t(v % 2 ? code(rng) : 0);
-    append_vertex(chunk, s);
-  }
+  const SampleChunk chunk =
+      random_chunk(rng, 4000, [&](int v, Sample &x) { x.resolution = uint16_t(v % 2 ? code(rng) : 0); });
   PhongFitOptions half_angle;
   half_angle.lobe = LobeForm::BlinnNH;
   PhongFitOptions ggx;
@@ -350,13 +359,9 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
 TEST_F(PhongFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
   std::mt19937 rng(23);
   std::uniform_real_distribution<float> u(0, 1);
-  SampleChunk chunk;
-  for (int v = 0; v < 4000; ++v) {
-    std::vector<Sample> s = random_vertex(rng);
-    const float scale = v % 4 == 0 ? 0.0f : v % 4 == 1 ? 1e-3f : v % 4 == 2 ? 0.02f : 0.3f;
-    for (Sample &x : s) x.footprint = scale * u(rng);
-    append_vertex(chunk, s);
-  }
+  const SampleChunk chunk = random_chunk(rng, 4000, [&](int v, Sample &x) {
+    x.footprint = (v % 4 == 0 ? 0.0f : v % 4 == 1 ? 1e-3f : v % 4 == 2 ? 0.02f : 0.3f) * u(rng);
+  });
   PhongFitOptions ggx;
   ggx.lobe = LobeForm::GgxNH;
   const Agreement a = agree(chunk, ggx, "GGX lobe through pixel footprints");

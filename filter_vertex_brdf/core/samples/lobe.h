@@ -74,22 +74,22 @@ inline double ggx_lobe_of_u(double u, double alpha) { return ggx_lobe_of_u_a2(u,
 // was). v is clamped to kMaxFootprintVariance (Tokuyoshi & Kaplanyan's clamp, 0.18).
 constexpr double kMaxFootprintVariance = 0.18;
 
-// GGX seen through a footprint of normal variance v >= 0 (see above), from u = 1 - s^2 and
-// a2 = ggx_a2(alpha): in (0, 1]; exactly ggx_lobe_of_u_a2(u, a2) at v = 0.
-inline double ggx_lobe_through_footprint(double u, double a2, double v) {
-  if (!(v > 0)) return ggx_lobe_of_u_a2(u, a2);
-  const double a2f = std::fmin(a2 + std::fmin(v, kMaxFootprintVariance), 1.0);
-  const double den = a2f + u * (1 - a2f);
-  return a2 * a2f / (den * den);  // (a^2 / a_f^2) (a_f^2 / den)^2 with one division
-}
-
-// The same for loops over many a2 at one sample: `v_clamped` = min(v, kMaxFootprintVariance) >= 0
-// taken once; no branch (vectorises); at v_clamped = 0 equal to ggx_lobe_of_u_a2 up to rounding.
+// GGX seen through a footprint whose variance is already clamped, v_clamped = min(v,
+// kMaxFootprintVariance) >= 0 (clamped_footprint), from u = 1 - s^2 and a2 = ggx_a2(alpha): no
+// branch, for loops over many a2 at one sample (vectorises); at 0 equal to ggx_lobe_of_u_a2 up to
+// rounding.
 inline double ggx_lobe_through_clamped_footprint(double u, double a2, double v_clamped) {
   const double a2f = std::fmin(a2 + v_clamped, 1.0), den = a2f + u * (1 - a2f);
-  return a2 * a2f / (den * den);
+  return a2 * a2f / (den * den);  // (a^2 / a_f^2) (a_f^2 / den)^2 with one division
 }
 inline double clamped_footprint(double v) { return v > 0 ? std::fmin(v, kMaxFootprintVariance) : 0.0; }
+
+// GGX seen through a footprint of normal variance v (see above; v <= 0 or NaN: none), from
+// u = 1 - s^2 and a2 = ggx_a2(alpha): in (0, 1]; exactly ggx_lobe_of_u_a2(u, a2) at v = 0.
+inline double ggx_lobe_through_footprint(double u, double a2, double v) {
+  if (!(v > 0)) return ggx_lobe_of_u_a2(u, a2);
+  return ggx_lobe_through_clamped_footprint(u, a2, clamped_footprint(v));
+}
 
 // g(s, alpha) of the form (see the header comment), for alpha >= 0. s <= 0 gives 0; s is clamped at
 // 1. Power forms: exp(max(alpha ln s, -80)) (no ln 0, no overflow, no denormals). GGX: a^2 in

@@ -254,6 +254,32 @@ float photo_resolution(const Raster &raster, const float position[3], const floa
 }
 
 namespace {
+// What Sample::footprint needs (footprint.h): the mesh's normal gradients (null: footprints off, or
+// no GGX lobe) and one FootprintCamera per distinct camera, camera_of[raster] (an RTI capture: one).
+struct FootprintSetup {
+  std::shared_ptr<const std::vector<float>> gradients;
+  std::vector<FootprintCamera> cameras;
+  std::vector<uint32_t> camera_of;
+};
+
+FootprintSetup footprint_setup(const MeshView &mesh, const std::vector<Raster> &rasters, const GatherSettings &settings) {
+  FootprintSetup f;
+  if (!settings.footprint || settings.lobe != LobeForm::GgxNH) return f;  // it matters to the GGX lobe only
+  f.gradients = settings.normal_gradients;
+  if (!f.gradients || f.gradients->size() != 9 * mesh.vertex_count)
+    f.gradients = std::make_shared<const std::vector<float>>(normal_gradients(mesh));
+  f.camera_of.assign(rasters.size(), 0);
+  for (size_t r = 0; r < rasters.size(); ++r) {
+    if (r > 0 && same_view(rasters[r], rasters[r - 1])) {
+      f.camera_of[r] = f.camera_of[r - 1];
+      continue;
+    }
+    f.camera_of[r] = uint32_t(f.cameras.size());
+    f.cameras.push_back(footprint_camera(rasters[r]));
+  }
+  return f;
+}
+
 // The samples of each active vertex, in its slots [slot_begin[a], slot_begin[a + 1]): drops those
 // that make_sample found not seen (moved to the front of the range, raster order kept; kept[a] =
 // how many stay), sets each kept sample's resolution code against the vertex's best photo (0 for
@@ -261,8 +287,7 @@ namespace {
 void finish_vertex_samples(std::vector<Sample> &samples, const std::vector<uint32_t> &slot_begin,
                            std::vector<uint32_t> &kept, const std::vector<Raster> &rasters, const MeshView &mesh,
                            size_t first, const std::vector<uint32_t> &active, bool resolution_weights,
-                           const std::vector<float> &gradients, const std::vector<FootprintCamera> &cameras,
-                           const std::vector<uint32_t> &camera_of, GatherStats &stats) {
+                           const FootprintSetup &footprints, GatherStats &stats) {
 #pragma omp parallel
   {
     uint64_t flag_counts[16] = {};
@@ -284,10 +309,10 @@ void finish_vertex_samples(std::vector<Sample> &samples, const std::vector<uint3
       for (Sample *s = begin; s != last; ++s) {
         for (uint16_t f = s->flags; f; f &= uint16_t(f - 1)) ++flag_counts[bit_index(uint16_t(f & -f))];
         s->resolution = best > 0 ? resolution_code(resolution[s->raster] / best) : 0;
-        if (!gradients.empty() && camera_of[s->raster] != footprint_camera_index) {
-          footprint_camera_index = camera_of[s->raster];
-          footprint = footprint_variance(cameras[footprint_camera_index], mesh.positions + 3 * v, mesh.normals + 3 * v,
-                                         gradients.data() + 9 * v);
+        if (footprints.gradients && footprints.camera_of[s->raster] != footprint_camera_index) {
+          footprint_camera_index = footprints.camera_of[s->raster];
+          footprint = footprint_variance(footprints.cameras[footprint_camera_index], mesh.positions + 3 * v,
+                                         mesh.normals + 3 * v, footprints.gradients->data() + 9 * v);
         }
         s->footprint = footprint;
         ++seen_vertices[s->raster];
@@ -319,25 +344,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     return settings.diffuse.at(v) == DiffuseForm::Coated ? as_coated : as_lambert;
   };
   const size_t raster_count = std::max<size_t>(rasters.size(), 1);
-  // The footprint's normal variance (footprint.h) matters to the GGX lobe only.
-  const bool footprint = settings.footprint && settings.lobe == LobeForm::GgxNH;
-  std::shared_ptr<const std::vector<float>> gradients_owned = settings.normal_gradients;
-  if (footprint && (!gradients_owned || gradients_owned->size() != 9 * mesh.vertex_count))
-    gradients_owned = std::make_shared<const std::vector<float>>(normal_gradients(mesh));
-  static const std::vector<float> kNone;
-  const std::vector<float> &gradients = footprint ? *gradients_owned : kNone;
-  // One footprint camera per distinct camera (an RTI capture: one for all photos), camera_of[raster].
-  std::vector<FootprintCamera> cameras;
-  std::vector<uint32_t> camera_of(rasters.size(), 0);
-  if (!gradients.empty())
-    for (size_t r = 0; r < rasters.size(); ++r) {
-      if (r > 0 && same_view(rasters[r], rasters[r - 1])) {
-        camera_of[r] = camera_of[r - 1];
-        continue;
-      }
-      camera_of[r] = uint32_t(cameras.size());
-      cameras.push_back(footprint_camera(rasters[r]));
-    }
+  const FootprintSetup footprints = footprint_setup(mesh, rasters, settings);
   // Chunks are sized as a dense vertices x rasters block of samples would fit the budget (the
   // samples stored are at most that).
   const size_t chunk_vertices = std::max<size_t>(
@@ -396,7 +403,7 @@ GatherStats gather_samples(const MeshView &mesh, const std::vector<Raster> &rast
     }
     std::vector<uint32_t> kept(active.size());
     finish_vertex_samples(chunk.samples, slot_begin, kept, rasters, mesh, first, active, settings.resolution_weights,
-                          gradients, cameras, camera_of, stats);
+                          footprints, stats);
     // Offsets over the chunk's vertices (no samples for those no photo sees); samples that the
     // footprint put off the photo leave gaps, closed in vertex order (rare: photo borders).
     chunk.first_vertex = uint32_t(first);
