@@ -24,6 +24,7 @@ const char *const kSpecularLobe = "specularLobe";
 const char *const kDiffuseTerm = "diffuseTerm";
 const char *const kFindMaterials = "findMaterials";
 const char *const kMaxIterations = "maxIterations";
+const char *const kSharpenAlbedo = "sharpenAlbedoEdges";
 const char *const kFillUnseenRings = "fillUnseenRings";
 
 std::string color_summary(const vbrdf::FitSettings &settings, const vbrdf::FitResult &result) {
@@ -119,6 +120,13 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "many; given only where the held-out photos show it helps); a diffuse material gets "
                            "none. Writes per-vertex 'material'; the report lists the materials. Holds better "
                            "from other cameras; costs about a seventh more time. On by default."));
+  params.addParam(RichBool(kSharpenAlbedo, vbrdf::FitSettings().deconvolve_albedo, "Sharpen albedo edges",
+                           "Where a photo's pixels straddle an albedo edge (a material boundary, a painted "
+                           "line), the sampled colour blends the vertices on both sides. On: those vertices' "
+                           "k_d C is deconvolved through the pixel footprints, kept only where the result "
+                           "still reproduces the photos (not where the colour is a texture finer than the "
+                           "mesh). Writes per-vertex 'diffuse_deconvolved'; the report says how many. On by "
+                           "default."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
@@ -165,6 +173,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.phong.min_specular_samples = shared::min_specular_samples(params);
   s.fill_unseen_rings = fill_rings;
   s.materials = params.getBool(kFindMaterials);
+  s.deconvolve_albedo = params.getBool(kSharpenAlbedo);
   s.quality = shared::quality_output(params);
   s.color_correction = shared::color_correction(params);
   s.chart_corners = shared::chart_corners(params);

@@ -287,10 +287,12 @@ HeldOut load_heldout(const Args &a, const MeshData &mesh) {
 // every seen, lit, unsaturated vertex sample, the held-out photo sampled bilinearly at the
 // vertex's pixel, vertices without a model black) beside per-pixel PTM and Relight-style RBF fitted
 // on the training photos of the same camera and scored on the same samples (relight.h).
-// `lobe`, `diffuse`: the forms the fit used (FitSettings::phong.lobe, FitRunResult::diffuse_forms):
+// `lobe`, `diffuse`: the forms the fit used (FitSettings::phong.lobe, FitResult::diffuse_forms), and
+// `deconvolved` its FitResult::albedo_deconvolved:
 // the renderer and the sample-based evaluation must evaluate the model the fit made.
 void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<VertexFit> &fits, LobeForm lobe,
-                      const DiffuseForms &diffuse, const std::vector<Raster> &training,
+                      const DiffuseForms &diffuse, const std::vector<uint8_t> &deconvolved,
+                      const std::vector<Raster> &training,
                       const std::vector<LightSource> &training_lights, const GetProcAddressFn &get_proc, Json &out) {
   const HeldOut h = load_heldout(a, mesh);
   const auto t = Clock::now();
@@ -316,6 +318,7 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
   ro.gather.lobe = lobe;  // the samples' lobe cosine and diffuse factor in the fit's forms
   ro.gather.diffuse = diffuse;
   ro.rendered = &rendered;
+  if (!deconvolved.empty()) ro.diffuse_deconvolved = &deconvolved;  // albedo seen through the footprints
   ro.training_rasters = &training;
   ro.training_lights = &training_lights;
   const RelightStats ws = evaluate_relighting(mesh.view(), fits, h.rasters, h.lights, *visibility, ro);
@@ -399,7 +402,7 @@ int cmd_fit(const Args &a) {
   out.num("converged", double(r.fit_converged));
   out.num("alpha_iterations", double(r.fit_iterations));
   if (!a.get("heldout").empty())
-    evaluate_heldout(a, mesh, r.fits, settings.phong.lobe, r.diffuse_forms, input.rasters,
+    evaluate_heldout(a, mesh, r.fits, settings.phong.lobe, r.diffuse_forms, r.albedo_deconvolved, input.rasters,
                      resolve_lights(input.rasters, r.light_file,
                                     light_placement_of(mesh.view(), 0.0f, 0.0f)),
                      get_proc, out);

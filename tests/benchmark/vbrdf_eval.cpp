@@ -23,7 +23,9 @@
 // --predict: how the product predicts a held-out sample. render (default): as the camera records
 // it (relight.h RelightOptions::rendered): the vertex's model where its pixel footprint shows its
 // own surface, the model rendered with 4x4 subpixels where it covers background or another surface
-// (silhouettes, contacts); vertex: the vertex's model alone (ignores what else the footprint covers).
+// (silhouettes, contacts), and at vertices whose albedo was deconvolved (diffuse_deconvolved = 1) the
+// diffuse reflectance seen through the footprint (tools/relight.h RelightOptions::diffuse_deconvolved);
+// vertex: the vertex's model alone (ignores what else the footprint covers).
 // --gt-lit: ground-truth lit flags per held-out light (load_lit below) instead of our shadow passes.
 // --samples-csv FILE: every scored sample (vertex, held-out photo, fit_status, mixed footprint, diffuse
 //   factor, observed and predicted linear RGB, CIEDE2000 of the product, PTM and RBF: -1 where not
@@ -191,7 +193,8 @@ int main(int argc, char **argv) {
     const ResultPly result = read_result_ply(result_path);
     LobeForm lobe = LobeForm::PhongRE;
     DiffuseForms diffuse;
-    const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe, &diffuse);
+    std::vector<uint8_t> deconvolved;
+    const std::vector<VertexFit> fits = fits_from_result(result, result_path, &lobe, &diffuse, &deconvolved);
     const MeshView mesh_view = result.mesh.view();
     const LightPlacement placement =
         light_placement_of(mesh_view, dome_radius, light_unit_scale);
@@ -235,6 +238,7 @@ int main(int argc, char **argv) {
       for (size_t r = 0; r < heldout.project.rasters.size(); ++r)
         rendered.push_back(render_as_photographed(*renderer, heldout.project.rasters[r].shot, heldout.lights[r]));
       options.rendered = &rendered;
+      options.diffuse_deconvolved = &deconvolved;  // their albedo as each camera records it
     } else if (predict != "vertex") {
       throw InputError("--predict takes 'render' or 'vertex'");
     }

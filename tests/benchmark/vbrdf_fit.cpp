@@ -5,7 +5,7 @@
 //             [--photo-dir DIR] [--color-correction off|auto|required] [--materials on|off] [--max-materials 4]
 //             [--photo-shadows on|off]
 //             [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
-//             [--footprint on|off]
+//             [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -36,7 +36,7 @@ int usage() {
                "                 [--min-heldout-photos N]\n"
                "                 [--photo-shadows on|off]\n"
                "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n"
-               "                 [--footprint on|off]\n";
+               "                 [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]\n";
   return 2;
 }
 } // namespace
@@ -74,6 +74,10 @@ int main(int argc, char **argv) {
       else return usage();
     } else if (a == "--resolution-weights") settings.gather.resolution_weights = next() == "on";
     else if (a == "--footprint") settings.gather.footprint = next() == "on";
+    else if (a == "--deconvolve") settings.deconvolve_albedo = next() == "on";
+    else if (a == "--deconvolve-lambda") settings.deconvolution.lambda = std::stof(next());
+    else if (a == "--deconvolve-edge") settings.deconvolution.edge_contrast = std::stof(next());
+    else if (a == "--deconvolve-misfit") settings.deconvolution.misfit_tolerance = std::stof(next());
     else if (a == "--material-lobes-everywhere") settings.material_options.keep_full_fits = false;
     else if (a == "--no-robust-colour") settings.material_options.robust_colour = false;
     else if (a == "--max-materials") settings.material_options.max_materials = std::stoi(next());

@@ -74,6 +74,7 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
   EXPECT_EQ(s.phong.min_specular_samples, core.phong.min_specular_samples);
   EXPECT_EQ(s.fill_unseen_rings, core.fill_unseen_rings);
   EXPECT_EQ(s.materials, core.materials);
+  EXPECT_EQ(s.deconvolve_albedo, core.deconvolve_albedo);
   EXPECT_EQ(s.quality, core.quality);
   EXPECT_EQ(s.color_correction, core.color_correction);
   EXPECT_TRUE(s.chart_corners.empty());
@@ -101,6 +102,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("specularLobe", EnumValue(0));
   p.setValue("diffuseTerm", EnumValue(1));
   p.setValue("findMaterials", BoolValue(true));
+  p.setValue("sharpenAlbedoEdges", BoolValue(false));
   p.setValue("maxIterations", IntValue(7));
   p.setValue("minSpecularSamples", IntValue(3));
   p.setValue("fillUnseenRings", IntValue(4));
@@ -121,6 +123,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_EQ(s.phong.lobe, vbrdf::LobeForm::PhongRE);
   EXPECT_EQ(s.diffuse_choice, vbrdf::DiffuseTermChoice::Lambert);
   EXPECT_TRUE(s.materials);
+  EXPECT_FALSE(s.deconvolve_albedo);
   EXPECT_EQ(s.gather.photo_cache_bytes, size_t(100) << 20);
   EXPECT_EQ(s.visibility_choice, vbrdf::VisibilityChoice::CPU);
   EXPECT_FLOAT_EQ(s.visibility.depth_tolerance, 0.01f);

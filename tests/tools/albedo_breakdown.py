@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Where the albedo error of a fit comes from (issue 9's "albedo over all visible vertices").
 
-    tests/tools/albedo_breakdown.py FIT.ply SCENE_DIR [--ior X]
+    tests/tools/albedo_breakdown.py FIT.ply SCENE_DIR [--ior X] [--max-mean M] [--max-p95 P]
+    tests/tools/albedo_breakdown.py --fit-tool vbrdf_fit --work DIR SCENE_DIR [...]
 
 FIT.ply: a fit of SCENE_DIR/project.mlp (vbrdf_fit or the filter); SCENE_DIR: a shared scene
 folder holding gt_vertex.npz and gt_scene.json (camera origin, materials). Score: the fit's
@@ -20,11 +21,16 @@ Prints, besides the score:
     divided by the coating's Fresnel transmission at their exit angle, T(theta_o) / T(0) (N.E
     clipped at 0.15) with the ground-truth material (an oracle) and with coated vertices chosen
     from the fit's specular evidence (coated_from_fit).
-Only the standard library and numpy. Exit status 0, or 2 on bad arguments.
+--fit-tool / --work: fit SCENE_DIR/project.mlp first (its photos, colour correction Auto: issue 9's
+protocol, "colour correction Auto where a chart is in view"; the fit's other defaults) into
+DIR/fit.ply. --max-mean / --max-p95: bounds on the acceptance figure (issue 9: 2.5 and 8).
+Only the standard library and numpy. Exit status 0, 1 when a bound is exceeded or the fit fails,
+2 on bad arguments.
 """
 import argparse
 import json
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -63,10 +69,29 @@ def coated_from_fit(v, faces, rings):
 
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("fit")
-    ap.add_argument("scene")
+    ap.add_argument("paths", nargs="+", help="FIT.ply SCENE_DIR, or SCENE_DIR with --fit-tool")
     ap.add_argument("--ior", type=float, default=None, help="coating IOR (default: the scene's roughplastic int_ior)")
+    ap.add_argument("--fit-tool", help="vbrdf_fit: fit SCENE_DIR/project.mlp first (colour correction auto)")
+    ap.add_argument("--work", help="with --fit-tool: the folder for fit.ply and fit.log")
+    ap.add_argument("--max-mean", type=float, default=None)
+    ap.add_argument("--max-p95", type=float, default=None)
     a = ap.parse_args(argv)
+    if a.fit_tool:
+        if len(a.paths) != 1 or not a.work:
+            ap.error("--fit-tool takes --work DIR and one SCENE_DIR")
+        a.scene = a.paths[0]
+        os.makedirs(a.work, exist_ok=True)
+        a.fit = os.path.join(a.work, "fit.ply")
+        with open(os.path.join(a.work, "fit.log"), "w") as log:
+            run = subprocess.run([a.fit_tool, os.path.join(a.scene, "project.mlp"), "--color-correction", "auto",
+                                  "--out", a.fit], stdout=log, stderr=subprocess.STDOUT)
+        if run.returncode != 0:
+            print(f"FAIL: {a.fit_tool} exit {run.returncode} (see {a.work}/fit.log)")
+            return 1
+    elif len(a.paths) == 2:
+        a.fit, a.scene = a.paths
+    else:
+        ap.error("give FIT.ply SCENE_DIR, or --fit-tool with one SCENE_DIR")
     gt_npz = os.path.join(a.scene, "gt_vertex.npz")
     if not os.path.isfile(gt_npz) or not os.path.isfile(a.fit):
         print(f"error: need {a.fit} and {gt_npz}", file=sys.stderr)
@@ -87,9 +112,15 @@ def main(argv):
     def score(e, label, sel=vis):
         r = lib.colour_errors(e[sel], gt[sel], "diag")
         print(f"  {label:<58s} mean {r['mean_de2000']:5.2f}  p95 {r['p95_de2000']:5.2f}")
+        return r
 
     print(f"{a.fit}: {vis.sum()} visible vertices, {clean.sum()} coloured=1, {rim.sum()} coloured=2")
-    score(est, "all visible (the acceptance figure)")
+    acceptance = score(est, "all visible (the acceptance figure)")
+    failures = []
+    if a.max_mean is not None and not acceptance["mean_de2000"] < a.max_mean:
+        failures.append(f"mean {acceptance['mean_de2000']:.2f} not below {a.max_mean}")
+    if a.max_p95 is not None and not acceptance["p95_de2000"] < a.max_p95:
+        failures.append(f"p95 {acceptance['p95_de2000']:.2f} not below {a.max_p95}")
     score(est, "clean-pixel vertices (coloured 1), own gain", clean)
 
     gain = lib.fit_colour_map(est[vis], gt[vis], "diag")
@@ -147,6 +178,9 @@ def main(argv):
     e5 = est.copy(); e5[coated] /= t_rel[coated, None]
     agree = (coated[vis] == glossy[vis]).mean()
     score(e5, f"same, coated chosen from the fit (16 rings; {agree:.0%} right)")
+    if failures:
+        print("FAIL: albedo over all visible vertices: " + "; ".join(failures))
+        return 1
     return 0
 
 

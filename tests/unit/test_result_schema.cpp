@@ -1,6 +1,7 @@
 // Result schema (core/result_schema.h): the PLY writer and reader address every per-vertex
 // attribute by name; a write/read round trip keeps each one, and the file format stays the one
 // existing result files, tools and the README table use.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <gtest/gtest.h>
@@ -30,6 +31,7 @@ VertexRecord distinct_record(size_t v) {
   r.fit.status = uint8_t(v % 5);
   r.fit.iterations = uint16_t(31 + v);
   r.diffuse_form = float(v % 2);
+  r.diffuse_deconvolved = float((v / 2) % 2);  // not equal to diffuse_form at every vertex
   return r;
 }
 
@@ -56,7 +58,8 @@ TEST(ResultSchema, FileFormatIsTheDocumentedOne) {
       "float diffuse_r", "float diffuse_g", "float diffuse_b", "float n_visible", "float n_diffuse",
       "float n_specular", "float coloured", "float kd", "float ks", "float shininess", "float color_r",
       "float color_g", "float color_b", "float dq", "float sq", "float fit_rmse", "float fit_status",
-      "float fit_iterations", "float material", "float lobe_form", "float diffuse_form"};
+      "float fit_iterations", "float material", "float lobe_form", "float diffuse_form",
+      "float diffuse_deconvolved"};
   const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
   const size_t n = mesh.positions.size() / 3;
   const std::string dir = test::scratch_dir("schema_format");
@@ -104,7 +107,18 @@ TEST(ResultSchema, EachPropertyHoldsItsOwnField) {
     EXPECT_FLOAT_EQ(at("fit_rmse"), r.fit.rmse);
     EXPECT_FLOAT_EQ(at("fit_status"), float(r.fit.status));
     EXPECT_FLOAT_EQ(at("fit_iterations"), float(r.fit.iterations));
+    EXPECT_FLOAT_EQ(at("diffuse_form"), r.diffuse_form);
+    EXPECT_FLOAT_EQ(at("diffuse_deconvolved"), r.diffuse_deconvolved);
   }
+  // fits_from_result hands the deconvolution flags back (absent: 0 everywhere).
+  std::vector<uint8_t> flags;
+  fits_from_result(back, path, nullptr, nullptr, &flags);
+  ASSERT_EQ(flags.size(), n);
+  for (size_t v = 0; v < n; ++v) EXPECT_EQ(flags[v], records[v].diffuse_deconvolved > 0.5f ? 1 : 0);
+  ResultPly without = back;
+  without.vertex_properties.erase("diffuse_deconvolved");
+  fits_from_result(without, path, nullptr, nullptr, &flags);
+  EXPECT_EQ(std::count(flags.begin(), flags.end(), uint8_t(1)), 0);
 }
 
 // diffuse_form: one form when every modelled vertex has it (unmodelled ones do not count), else a

@@ -194,6 +194,51 @@ void fill_gaps(const FitInput &input, const FitSettings &settings, const LogFn &
         " seen vertices have no usable sample and no vertex of the mesh has a model: left without a model.");
 }
 
+// The fit's k_d C deconvolved through the photos' pixel footprints (albedo_deconvolution.h), at the
+// vertices fitted from their own samples (fit_status 1, 2, 4): neighbour-filled ones are copies.
+void deconvolve_fit_albedo(const FitInput &input, const FitSettings &settings, const VisibilityMasks &masks,
+                           const LogFn &log, FitResult &r) {
+  const MeshView &mesh = input.mesh;
+  const size_t n = mesh.vertex_count;
+  std::vector<uint8_t> own(n, 0);
+  std::vector<float> b(3 * n, 0.0f), x(3 * n, 0.0f);
+  for (size_t v = 0; v < n; ++v) {
+    const VertexFit &f = r.fits[v];
+    own[v] = f.status == kFitFull || f.status == kFitDiffuseOnly || f.status == kFitFromWeakSamples;
+    if (has_model(f))
+      for (int c = 0; c < 3; ++c) b[3 * v + size_t(c)] = f.kd * f.color[c];
+  }
+  std::vector<size_t> all(input.rasters.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  EdgeFilter edges;  // rows only where the footprint can span an edge
+  edges.rgb = b.data();
+  edges.contrast = settings.deconvolution.edge_contrast;
+  const FootprintRows rows = footprint_rows(mesh, input.rasters, masks, all, own.data(),
+                                            settings.visibility.depth_tolerance * compute_bounds(mesh).diagonal(), &edges);
+  r.albedo_deconvolved.assign(n, 0);
+  r.deconvolution =
+      deconvolve_albedo(rows, n, b.data(), own.data(), settings.deconvolution, x.data(), r.albedo_deconvolved.data());
+  if (r.deconvolution.solved) {
+    for (size_t v = 0; v < n; ++v) {
+      if (!r.albedo_deconvolved[v]) continue;
+      VertexFit &f = r.fits[v];
+      const float *rho = &x[3 * v];
+      const float kd = std::max(rho[0], std::max(rho[1], rho[2]));
+      f.kd = kd;
+      for (int c = 0; c < 3; ++c) f.color[c] = kd > 0 ? rho[c] / kd : 0.0f;
+    }
+    r.deconvolution.note =
+        std::to_string(r.deconvolution.written) + " vertices' k_d C deconvolved (of " +
+        std::to_string(r.deconvolution.edge_vertices) + " whose pixel footprints span an albedo edge, contrast above " +
+        std::to_string(int(std::lround(100 * settings.deconvolution.edge_contrast))) + " %; the others' footprints are "
+        "not a blend of the vertices' colours, e.g. a texture finer than the mesh); lambda " +
+        fixed(settings.deconvolution.lambda) + ", " + std::to_string(r.deconvolution.rounds) + " solve(s), " +
+        std::to_string(r.deconvolution.iterations) + " CG iterations; through the footprints they give the fit's colours "
+        "to " + fixed(100 * r.deconvolution.reblur_rms, 1) + " % RMS";
+  }
+  log("Albedo deconvolution: " + r.deconvolution.note + ".");
+}
+
 } // namespace
 
 namespace {
@@ -373,6 +418,9 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   if (settings.fit_reflectance) fill_gaps(input, settings, log, result);
   result.seconds_fill = seconds_since(t);
   if (with_materials) propagate_material_labels(mesh, result.fits, result.materials.label);
+  t = Clock::now();
+  if (settings.fit_reflectance && settings.deconvolve_albedo) deconvolve_fit_albedo(input, settings, masks, log, result);
+  result.seconds_deconvolution = seconds_since(t);
 
   t = Clock::now();
   build_outputs(input, settings, result);

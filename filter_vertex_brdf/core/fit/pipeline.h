@@ -12,6 +12,7 @@
 #include "calibration/color_chart.h"
 #include "calibration/color_plan.h"  // ColorCorrectionChoice: Off, Auto (where a chart is found), Required
 #include "samples/diffuse_color.h"
+#include "fit/albedo_deconvolution.h"
 #include "fit/fit_backends.h"  // VisibilityChoice, FitBackendChoice, PhongFitter, their factories
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
@@ -85,6 +86,13 @@ struct FitSettings {
   // Samples far darker than their vertex's model although the mesh lets the light reach them
   // (photo_shadows.h): left out, the vertex refitted. On by default; off for comparisons.
   PhotoShadowSettings photo_shadows;
+  // The diffuse reflectance deconvolved through the photos' pixel footprints where they straddle an
+  // albedo edge (fit/albedo_deconvolution.h): each vertex's own albedo instead of the footprint's
+  // blend of its neighbours' (sharp material boundaries and painted lines). The result's
+  // diffuse_deconvolved = 1 marks those vertices; the relighting evaluation predicts photos there
+  // through the same footprints. Phong fit only. On by default since 2026-12-04 (README "Tenth step").
+  bool deconvolve_albedo = true;
+  DeconvolutionSettings deconvolution;
 };
 
 struct FitInput {
@@ -121,6 +129,10 @@ struct FitResult {
   size_t rim_samples_demoted = 0;           // rim samples left out: their vertex has clean ones
   size_t photo_shadow_samples = 0, photo_shadow_vertices = 0;  // photo_shadows.h: flagged, refitted
   NeighbourFillStats fill;
+  // Per vertex, 1 where k_d C was deconvolved through the footprints (FitSettings::deconvolve_albedo);
+  // empty when the stage did not run.
+  std::vector<uint8_t> albedo_deconvolved;
+  DeconvolutionStats deconvolution;
   MaterialResult materials;               // material stage (FitSettings::materials); label empty when off
   DiffuseForms diffuse_forms;             // the forms fitted, per vertex where they vary (FitSettings::diffuse_choice)
   std::string diffuse_choice_note;        // how it was decided (report line; diffuse_choice.h for Auto)
@@ -140,8 +152,9 @@ struct FitResult {
   double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
   // The stages around those (the report's second time line): colour chart search and correction
   // plan (in a thread of its own during the visibility passes, so not on the wall clock's path
-  // unless it outlasts them), photo content checks, the diffuse-form pilot, the material stage and the neighbour fill.
-  double seconds_colors = 0, seconds_photo_checks = 0, seconds_pilot = 0, seconds_materials = 0, seconds_fill = 0;
+  // unless it outlasts them), photo content checks, the diffuse-form pilot, the material stage, the neighbour fill and the albedo deconvolution.
+  double seconds_colors = 0, seconds_photo_checks = 0, seconds_pilot = 0, seconds_materials = 0, seconds_fill = 0,
+         seconds_deconvolution = 0;
 };
 
 // Runs the pipeline and writes the PLY and the report (<ply stem>_report.txt). Nothing is

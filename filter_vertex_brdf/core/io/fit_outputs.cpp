@@ -107,6 +107,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       rec.fit = f;
       rec.lobe_form = float(uint8_t(settings.phong.lobe));
       rec.diffuse_form = float(uint8_t(r.diffuse_forms.at(v)));
+      rec.diffuse_deconvolved = v < r.albedo_deconvolved.size() ? float(r.albedo_deconvolved[v]) : 0.0f;
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -179,6 +180,12 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
                                                       "the surface's own; a renderer filters it per pixel)")
                                         : std::string("; the lobe at the vertex alone (no pixel footprint)"))
         << "\n";
+  if (settings.fit_reflectance)
+    rep << "albedo deconvolution: "
+        << (!settings.deconvolve_albedo ? std::string("off (k_d C as the photos' pixel footprints blend it)")
+                                        : r.deconvolution.note + " (per-vertex diffuse_deconvolved = 1: predict a photo "
+                                                                 "through its footprint)")
+        << "\n";
   if (!r.fits.empty()) {
     rep << "Phong fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
@@ -217,7 +224,8 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
   rep << "time, other stages: colour chart search and correction " << fixed(r.seconds_colors)
       << " s (beside the visibility passes), photo checks "
       << fixed(r.seconds_photo_checks) << " s, diffuse-form pilot " << fixed(r.seconds_pilot) << " s, materials "
-      << fixed(r.seconds_materials) << " s, neighbour fill " << fixed(r.seconds_fill) << " s\n";
+      << fixed(r.seconds_materials) << " s, neighbour fill " << fixed(r.seconds_fill) << " s, albedo deconvolution "
+      << fixed(r.seconds_deconvolution) << " s\n";
   return rep.str();
 }
 

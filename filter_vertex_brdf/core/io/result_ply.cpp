@@ -115,7 +115,7 @@ ResultPly read_result_ply(const std::string &path) {
 }
 
 std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe,
-                                        DiffuseForms *diffuse) {
+                                        DiffuseForms *diffuse, std::vector<uint8_t> *deconvolved) {
   const std::string missing = first_missing_model_attribute(result.vertex_properties);
   if (!missing.empty())
     throw InputError("Result '" + path + "' has no per-vertex '" + missing +
@@ -125,6 +125,10 @@ std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::stri
   for (const VertexRecord &record : records) fits.push_back(record.fit);
   if (lobe) *lobe = lobe_form_of(records, path);
   if (diffuse) *diffuse = diffuse_forms_of(records);
+  if (deconvolved) {
+    deconvolved->resize(records.size());
+    for (size_t v = 0; v < records.size(); ++v) (*deconvolved)[v] = records[v].diffuse_deconvolved > 0.5f;
+  }
   return fits;
 }
 

@@ -26,8 +26,9 @@ ResultPly read_result_ply(const std::string &path);
 // Throws InputError naming the first missing attribute needed for the model (kd, ks, shininess,
 // color_r/g/b, fit_status), or a column of the wrong length.
 // `lobe` and `diffuse` (optional) receive the result's lobe and diffuse forms (lobe_form_of,
-// diffuse_forms_of).
+// diffuse_forms_of); `deconvolved` (optional) one flag per vertex: its k_d C was deconvolved through
+// the pixel footprints (diffuse_deconvolved; absent: 0).
 std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::string &path, LobeForm *lobe = nullptr,
-                                        DiffuseForms *diffuse = nullptr);
+                                        DiffuseForms *diffuse = nullptr, std::vector<uint8_t> *deconvolved = nullptr);
 
 } // namespace vbrdf

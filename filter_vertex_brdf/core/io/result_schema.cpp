@@ -67,6 +67,12 @@ std::vector<ResultAttribute> make_schema() {
        "the diffuse term's form that kd multiplies at the vertex: 0 Lambert (N.L, the thesis), 1 coated (N.L with "
        "a clear coat's Fresnel transmission in and out, index 1.5) (absent: 0)",
        [](const R &r) { return r.diffuse_form; }, [](R &r, float v) { r.diffuse_form = whole(v, 1.0f); }},
+      {"diffuse_deconvolved", K::Code, G::PhongFit, false,
+       "1: k_d C is the vertex's own reflectance, deconvolved from the photos' pixel footprints (a photo's sample is "
+       "predicted through the footprint's weights over the neighbouring vertices); 0: as the photos' samples show "
+       "it (absent: 0)",
+       [](const R &r) { return r.diffuse_deconvolved; },
+       [](R &r, float v) { r.diffuse_deconvolved = whole(v, 1.0f); }},
   };
 }
 } // namespace

@@ -24,6 +24,7 @@ struct VertexRecord {
   float material = 0.0f;  // material stage (materials.h): 1..K, 0 = none (stage off, or no model)
   float lobe_form = 0.0f;  // LobeForm of the fit (samples/lobe.h): 0 R.E, 1 N.H; one value per result
   float diffuse_form = 0.0f;  // DiffuseForm at the vertex (samples/diffuse_form.h): 0 Lambert, 1 coated
+  float diffuse_deconvolved = 0.0f;  // 1: k_d C deconvolved through the pixel footprints (albedo_deconvolution.h)
   VertexFit fit = {{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0, kFitNone, 0};  // sentinels
 };
 

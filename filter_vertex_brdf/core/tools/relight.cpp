@@ -5,6 +5,7 @@
 
 #include "base/color_difference.h"
 #include "base/errors.h"
+#include "samples/footprint_weights.h"
 #include "tools/rti_baselines.h"
 
 namespace vbrdf {
@@ -140,6 +141,56 @@ void predict_footprint(const cv::Mat &rendered, float x, float y, uint8_t own, c
   }
 }
 
+// The diffuse reflectance each held-out camera records at the deconvolved vertices
+// (RelightOptions::diffuse_deconvolved): k_d C seen through the camera's pixel footprints.
+struct SeenAlbedo {
+  std::vector<int32_t> camera_of_raster;  // -1: not a held-out raster
+  std::vector<std::vector<float>> rgb;    // per camera: 3 per vertex
+  std::vector<std::vector<uint8_t>> known;  // per camera: 1 per vertex where rgb is set
+
+  // `fit` with k_d C replaced by what raster r's camera records at v (unchanged where not known).
+  VertexFit as_seen(const VertexFit &fit, size_t r, size_t v) const {
+    if (r >= camera_of_raster.size() || camera_of_raster[r] < 0) return fit;
+    const size_t c = size_t(camera_of_raster[r]);
+    if (!known[c][v]) return fit;
+    VertexFit seen = fit;
+    const float *rho = &rgb[c][3 * v];
+    seen.kd = std::max(rho[0], std::max(rho[1], rho[2]));
+    for (int k = 0; k < 3; ++k) seen.color[k] = seen.kd > 0 ? rho[k] / seen.kd : 0.0f;
+    return seen;
+  }
+};
+
+SeenAlbedo seen_albedo(const MeshView &mesh, const std::vector<VertexFit> &fits, const std::vector<Raster> &all,
+                       size_t n_held, const VisibilityMasks &masks, const RelightOptions &options) {
+  SeenAlbedo out;
+  if (!options.diffuse_deconvolved) return out;
+  const size_t n = mesh.vertex_count;
+  std::vector<uint8_t> wanted(n, 0);
+  for (size_t v = 0; v < n; ++v)
+    wanted[v] = (*options.diffuse_deconvolved)[v] && has_model(fits[v]) &&
+                (!options.vertex_filter || (*options.vertex_filter)[v]);
+  if (std::none_of(wanted.begin(), wanted.end(), [](uint8_t w) { return w != 0; })) return out;
+  std::vector<size_t> held(n_held);
+  for (size_t r = 0; r < n_held; ++r) held[r] = r;
+  const FootprintRows rows = footprint_rows(mesh, all, masks, held, wanted.data(),
+                                            VisibilitySettings().depth_tolerance * compute_bounds(mesh).diagonal());
+  std::vector<float> rho(3 * n, 0.0f), blurred(3 * rows.rows());
+  for (size_t v = 0; v < n; ++v)
+    if (has_model(fits[v]))
+      for (int c = 0; c < 3; ++c) rho[3 * v + size_t(c)] = fits[v].kd * fits[v].color[c];
+  blur_through_footprints(rows, rho.data(), blurred.data());
+  out.camera_of_raster = rows.camera_of_raster;
+  out.rgb.assign(rows.camera_count, std::vector<float>(3 * n, 0.0f));
+  out.known.assign(rows.camera_count, std::vector<uint8_t>(n, 0));
+  for (size_t k = 0; k < rows.rows(); ++k) {
+    const size_t c = rows.row_camera[k], v = rows.row_vertex[k];
+    out.known[c][v] = 1;
+    for (int ch = 0; ch < 3; ++ch) out.rgb[c][3 * v + size_t(ch)] = blurred[3 * k + size_t(ch)];
+  }
+  return out;
+}
+
 void clamp_below_zero(float rgb[3]) {
   for (int c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c], 0.0f);
 }
@@ -162,6 +213,10 @@ void check_sizes(const MeshView &mesh, const std::vector<VertexFit> &fits, const
           (*options.rendered)[r].rows != rasters[r].height())
         throw InputError("Relighting evaluation: the rendered image of '" + rasters[r].label +
                          "' is not a linear RGB float image of the photo's size.");
+  if (options.diffuse_deconvolved && options.diffuse_deconvolved->size() != mesh.vertex_count)
+    throw InputError("Relighting evaluation: the deconvolution flags have " +
+                     std::to_string(options.diffuse_deconvolved->size()) + " entries for a mesh of " +
+                     std::to_string(mesh.vertex_count) + " vertices.");
   if (options.lit_filter && options.lit_filter->size() != mesh.vertex_count * rasters.size())
     throw InputError("Relighting evaluation: the lit filter has " + std::to_string(options.lit_filter->size()) +
                      " entries; expected held-out photos x vertices = " +
@@ -202,6 +257,7 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
   settings.own_surface_texels = false;
   const VisibilityMasks masks = compute_visibility(mesh, all, all_lights, visibility);
   PhotoCache photos(settings.encoding, settings.saturation_level, settings.photo_cache_bytes);
+  const SeenAlbedo seen_albedo_of = seen_albedo(mesh, fits, all, n_held, masks, options);
 
   std::vector<double> de_all, de_clean, de_base_product, de_ptm, de_rbf, fp_product[2], fp_rbf[2];
   double squared_error = 0;
@@ -235,7 +291,8 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
         o.d = s.d;
         r.modelled = has_model(fit);
         float predicted[3];
-        evaluate_phong(fit, s.d, s.lobe_cos, options.gather.lobe, predicted, s.footprint);
+        evaluate_phong(seen_albedo_of.as_seen(fit, s.raster, v), s.d, s.lobe_cos, options.gather.lobe, predicted,
+                       s.footprint);
         const float irradiance = light_irradiance_at(lights[s.raster], mesh.positions + 3 * v);
         for (float &c : predicted) c *= irradiance;
         const uint8_t own = masks.own_texels(s.raster, v);

@@ -44,6 +44,12 @@ struct RelightOptions {
   // (evaluate_phong) and, at silhouettes and contacts, the others (background, another surface)
   // take that image. Inside a surface this is exactly the vertex's model.
   const std::vector<cv::Mat> *rendered = nullptr;
+  // Optional (null = none): one flag per vertex, non-zero where the fit's k_d C is the vertex's own
+  // reflectance deconvolved from the photos' pixel footprints (the result's diffuse_deconvolved,
+  // fit/albedo_deconvolution.h). There the product predicts the held-out photo as its camera
+  // records it: the diffuse reflectance seen through the footprint (samples/footprint_weights.h:
+  // the weighted mean of the neighbouring vertices' k_d C), the lobe and shading the vertex's own.
+  const std::vector<uint8_t> *diffuse_deconvolved = nullptr;
   // Optional baselines (both null = off): the training rasters and their lights (the baselines,
   // per-pixel RTI, use one direction per photo: LightSource::direction, as RTI tools do).
   // For each held-out raster the training rasters of the same viewpoint (same_shot) are used; the
