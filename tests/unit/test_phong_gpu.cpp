@@ -265,6 +265,19 @@ protected:
     return out;
   }
 
+  // How many of the vertices that `counted` picks the CPU fits differently (parameter_difference
+  // above 1e-3) once `strip` has cleared a field of every sample: that the field matters to the fits.
+  static int vertices_changed_by(const SampleChunk &chunk, const PhongFitOptions &o,
+                                 const std::function<void(Sample &)> &strip,
+                                 const std::function<bool(uint32_t)> &counted) {
+    SampleChunk stripped = chunk;
+    for (Sample &x : stripped.samples) strip(x);
+    const std::vector<VertexFit> with = run_cpu(chunk, o), without = run_cpu(stripped, o);
+    int differ = 0;
+    for (uint32_t v = 0; v < chunk.vertex_count; ++v) differ += counted(v) && parameter_difference(with[v], without[v]) > 1e-3;
+    return differ;
+  }
+
   // Runs both back ends (and the CPU with a tightened tolerance unless `cap_stops`) and reports
   // the agreement; returns it for the caller's expectations.
   // `exponent`: the chunk's pixel values are 2^-exponent times ordinary ones (fits are compared
@@ -346,11 +359,8 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
     EXPECT_LE(a.well_disagree, a.well / 200);
   }
   // The weights matter: the same samples without them give other fits.
-  SampleChunk plain = chunk;
-  for (Sample &x : plain.samples) x.resolution = 0;
-  const std::vector<VertexFit> weighted = run_cpu(chunk, mirror), unweighted = run_cpu(plain, mirror);
-  int differ = 0;
-  for (uint32_t v = 1; v < chunk.vertex_count; v += 2) differ += parameter_difference(weighted[v], unweighted[v]) > 1e-3;
+  const int differ = vertices_changed_by(chunk, mirror, [](Sample &x) { x.resolution = 0; },
+                                         [](uint32_t v) { return v % 2 == 1; });
   EXPECT_GT(differ, int(chunk.vertex_count) / 8);
 }
 
@@ -367,11 +377,8 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
   const Agreement a = agree(chunk, ggx, "GGX lobe through pixel footprints");
   EXPECT_GT(a.well, 1000);
   EXPECT_LE(a.well_disagree, a.well / 200);
-  SampleChunk plain = chunk;
-  for (Sample &x : plain.samples) x.footprint = 0;
-  const std::vector<VertexFit> through = run_cpu(chunk, ggx), at_vertex = run_cpu(plain, ggx);
-  int differ = 0;
-  for (uint32_t v = 0; v < chunk.vertex_count; ++v) differ += v % 4 != 0 && parameter_difference(through[v], at_vertex[v]) > 1e-3;
+  const int differ = vertices_changed_by(chunk, ggx, [](Sample &x) { x.footprint = 0; },
+                                         [](uint32_t v) { return v % 4 != 0; });
   EXPECT_GT(differ, int(chunk.vertex_count) / 4);
 }
 

@@ -23,11 +23,7 @@ void row_range(const FootprintRows &rows, size_t k, const float *b, double low[3
 bool footprint_spans_an_edge(const FootprintRows &rows, size_t k, const float *b, float edge_contrast) {
   double low[3], high[3];
   row_range(rows, k, b, low, high);
-  const double top = std::max(high[0], std::max(high[1], high[2]));
-  if (!(top > 0)) return false;
-  for (int c = 0; c < 3; ++c)
-    if (high[c] - low[c] > double(edge_contrast) * top) return true;
-  return false;
+  return spans_albedo_edge(low, high, edge_contrast);
 }
 
 namespace {
@@ -169,7 +165,6 @@ DeconvolutionStats deconvolve_albedo(const FootprintRows &rows, size_t vertex_co
       ++stats.written;
       if (deconvolved) deconvolved[v] = 1;
     }
-  stats.unknowns = stats.written;
   stats.reblur_rms = stats.rows ? std::sqrt(sum / double(stats.rows)) : 0.0;
   return stats;
 }

@@ -46,13 +46,12 @@ struct DeconvolutionSettings {
   int max_rounds = 4;
 };
 
-// True when the fit's colours b over row k's vertices differ, in some channel, by more than
-// edge_contrast times the brightest of them: the footprint straddles an albedo edge.
+// True when the fit's colours b over row k's vertices span an albedo edge (spans_albedo_edge).
 bool footprint_spans_an_edge(const FootprintRows &rows, size_t k, const float *b, float edge_contrast);
 
 struct DeconvolutionStats {
   size_t edge_vertices = 0;                    // candidates: footprints spanning an edge
-  size_t rows = 0, unknowns = 0, written = 0;  // kept: rows and vertices (written = unknowns)
+  size_t rows = 0, written = 0;                // kept: their rows, and the vertices written
   int iterations = 0, rounds = 0;              // CG iterations (summed over rounds), solves
   // How well the kept result reproduces the fit's colours through the footprints: RMS over their
   // rows of row_misfit (the largest channel's |sum_u W x_u - b_v| over the footprint's brightest b).

@@ -306,12 +306,11 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
     } else {
       double rho[3] = {P.rho[3 * v], P.rho[3 * v + 1], P.rho[3 * v + 2]};
       if (mo.robust_colour) robust_rho(c, v, diffuse[m] ? 0.0 : P.ks[v], P.alpha[v], rho);
-      const double kd = std::max(rho[0], std::max(rho[1], rho[2]));
       if (!(S[v].a > 0) && !diffuse[m]) {
         // No diffuse information (cannot happen with a usable sample, but stay safe): keep k_d C.
       } else {
-        f.kd = float(std::min(kd, double(o.kd_max)));
-        for (int ch = 0; ch < 3; ++ch) f.color[ch] = kd > 0 ? float(std::min(1.0, rho[ch] / kd)) : 0.0f;
+        set_kd_color(rho, f);
+        f.kd = std::min(f.kd, o.kd_max);  // C from the uncapped k_d, as the per-vertex fit stores it
       }
       f.ks = diffuse[m] ? 0.0f : float(P.ks[v]);
       f.shininess = f.ks > 0 ? float(P.alpha[v]) : 0.0f;

@@ -36,10 +36,8 @@ bool average_of_neighbours(const MeshView &mesh, const Adjacency &adj, const std
   }
   if (!(wsum > 0)) return false;
   out = VertexFit{{0, 0, 0}, 0, 0, 0, 0, 0, 0, 0, kFitFromNeighbours, 0};
-  double kd = 0;
-  for (int c = 0; c < 3; ++c) rho[c] /= wsum, kd = std::max(kd, rho[c]);
-  out.kd = float(kd);
-  for (int c = 0; c < 3; ++c) out.color[c] = kd > 0 ? float(std::min(1.0, rho[c] / kd)) : 0.0f;
+  for (double &r : rho) r /= wsum;
+  set_kd_color(rho, out);
   if (w_alpha > 0) {  // a lobe only where some neighbour has one
     out.ks = float(ks / wsum);
     out.shininess = out.ks > 0 ? float(std::exp(log_alpha / w_alpha)) : 0.0f;

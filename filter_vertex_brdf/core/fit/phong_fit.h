@@ -116,6 +116,10 @@ void set_diffuse_only_reflectance(const Sample *samples, size_t count, const Pho
 void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOptions &options, bool weak,
                            VertexFit &fit);
 
+// Sets k_d and C from a diffuse reflectance rho = k_d C: k_d is its largest channel and C = rho / k_d
+// (largest channel 1); C = 0 when k_d <= 0. The one place that splits k_d C; other fields untouched.
+void set_kd_color(const double rho[3], VertexFit &fit);
+
 // Evaluates the model (for rendering, relighting and tests). Writes 3 channels.
 // d: the diffuse factor (Sample::d: N.L for Lambert, diffuse_factor() in general); lobe_cos and
 // form: the lobe's cosine (Sample::lobe_cos) and the form the fit used (PhongFitOptions::lobe).

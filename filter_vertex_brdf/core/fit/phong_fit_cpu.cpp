@@ -190,14 +190,18 @@ void set_sentinels(VertexFit &out) {
 }
 
 void store_linear(const Linear &L, double alpha, VertexFit &out) {
-  const double kd = std::max(L.rho[0], std::max(L.rho[1], L.rho[2]));
-  out.kd = float(kd);
-  for (int c = 0; c < 3; ++c) out.color[c] = kd > 0 ? float(std::min(1.0, L.rho[c] / kd)) : 0.0f;
+  set_kd_color(L.rho, out);
   out.ks = float(L.ks);
   out.shininess = out.ks > 0 ? float(alpha) : 0.0f;  // decided on the stored (float) k_s
 }
 
 } // namespace
+
+void set_kd_color(const double rho[3], VertexFit &fit) {
+  const double kd = std::max(rho[0], std::max(rho[1], rho[2]));
+  fit.kd = float(kd);
+  for (int c = 0; c < 3; ++c) fit.color[c] = kd > 0 ? float(std::min(1.0, rho[c] / kd)) : 0.0f;
+}
 
 void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out[3], float footprint) {
   const float d = std::max(d_in, 0.0f);

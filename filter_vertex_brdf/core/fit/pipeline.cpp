@@ -221,11 +221,8 @@ void deconvolve_fit_albedo(const FitInput &input, const FitSettings &settings, c
   if (r.deconvolution.solved) {
     for (size_t v = 0; v < n; ++v) {
       if (!r.albedo_deconvolved[v]) continue;
-      VertexFit &f = r.fits[v];
-      const float *rho = &x[3 * v];
-      const float kd = std::max(rho[0], std::max(rho[1], rho[2]));
-      f.kd = kd;
-      for (int c = 0; c < 3; ++c) f.color[c] = kd > 0 ? rho[c] / kd : 0.0f;
+      const double rho[3] = {x[3 * v], x[3 * v + 1], x[3 * v + 2]};
+      set_kd_color(rho, r.fits[v]);
     }
     r.deconvolution.note =
         std::to_string(r.deconvolution.written) + " vertices' k_d C deconvolved (of " +

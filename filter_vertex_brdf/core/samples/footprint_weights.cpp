@@ -189,29 +189,23 @@ std::vector<float> ring_ranges(const MeshAdjacency &adj, const float *rgb, size_
   return out;
 }
 
-bool exceeds_contrast(const float low[3], const float high[3], float contrast) {
-  const float top = std::max(high[0], std::max(high[1], high[2]));
-  for (int c = 0; c < 3; ++c)
-    if (top > 0 && high[c] - low[c] > contrast * top) return true;
-  return false;
-}
-
 // Whether the ranges of `vertices` (ring_ranges) together exceed the contrast.
 bool rings_span_contrast(const std::vector<uint32_t> &vertices, const std::vector<float> &ranges, float contrast) {
-  float low[3] = {1e30f, 1e30f, 1e30f}, high[3] = {-1e30f, -1e30f, -1e30f};
+  double low[3] = {1e30, 1e30, 1e30}, high[3] = {-1e30, -1e30, -1e30};
   for (uint32_t u : vertices)
-    for (int c = 0; c < 3; ++c) low[c] = std::min(low[c], ranges[6 * u + c]), high[c] = std::max(high[c], ranges[6 * u + 3 + c]);
-  return exceeds_contrast(low, high, contrast);
+    for (int c = 0; c < 3; ++c)
+      low[c] = std::min(low[c], double(ranges[6 * u + c])), high[c] = std::max(high[c], double(ranges[6 * u + 3 + c]));
+  return spans_albedo_edge(low, high, contrast);
 }
 
 // Whether `rgb` over the triangles' corners (every vertex a row can hold) differs, in some channel,
 // by more than contrast x the brightest.
 bool spans_contrast(const std::vector<ImageTriangle> &triangles, const float *rgb, float contrast) {
-  float low[3] = {1e30f, 1e30f, 1e30f}, high[3] = {-1e30f, -1e30f, -1e30f};
+  double low[3] = {1e30, 1e30, 1e30}, high[3] = {-1e30, -1e30, -1e30};
   for (const ImageTriangle &t : triangles)
     for (uint32_t u : t.corner)
-      for (int c = 0; c < 3; ++c) low[c] = std::min(low[c], rgb[3 * u + c]), high[c] = std::max(high[c], rgb[3 * u + c]);
-  return exceeds_contrast(low, high, contrast);
+      for (int c = 0; c < 3; ++c) low[c] = std::min(low[c], double(rgb[3 * u + c])), high[c] = std::max(high[c], double(rgb[3 * u + c]));
+  return spans_albedo_edge(low, high, contrast);
 }
 
 } // namespace
@@ -294,6 +288,14 @@ FootprintRows footprint_rows(const MeshView &mesh, const std::vector<Raster> &ra
     }
   }
   return out;
+}
+
+bool spans_albedo_edge(const double low[3], const double high[3], double contrast) {
+  const double top = std::max(high[0], std::max(high[1], high[2]));
+  if (!(top > 0)) return false;
+  for (int c = 0; c < 3; ++c)
+    if (high[c] - low[c] > contrast * top) return true;
+  return false;
 }
 
 void blur_through_footprints(const FootprintRows &rows, const float *rgb, float *out) {

@@ -47,17 +47,20 @@ struct FootprintRows {
   size_t rows() const { return row_vertex.size(); }
 };
 
+// The albedo-edge rule: colours whose per-channel ranges [low, high] differ, in some channel, by
+// more than `contrast` times the brightest of them (the largest high; none positive: no edge).
+bool spans_albedo_edge(const double low[3], const double high[3], double contrast);
+
 // The rows of every vertex with wanted[v] != 0 (null: every vertex) seen and lit by at least one of
 // the rasters `raster_indices` (indices into `rasters` and `masks`), one row per camera that sees it.
 // `depth_tolerance`: the visibility passes' tolerance in world units (VisibilitySettings::
 // depth_tolerance times the mesh's bounding-box diagonal). OpenMP over vertices; each camera
 // projects every vertex once. Safeguards: out-of-range indices and degenerate (zero-area) triangles
 // are skipped; a vertex behind the camera or whose footprint has no own texel gets no row.
-// `edge` (optional): rows only where per-vertex colours `edge->rgb` (3 per vertex) differ, in some
-// channel, by more than edge->contrast times the brightest over the corners of the triangles the
-// footprint may cover (a superset of its row's vertices, v included): the rows that can span an
-// albedo edge, without building the others (fit/albedo_deconvolution.h footprint_spans_an_edge
-// then decides on the row itself).
+// `edge` (optional): rows only where per-vertex colours `edge->rgb` (3 per vertex) span an albedo
+// edge (spans_albedo_edge, edge->contrast) over the corners of the triangles the footprint may
+// cover (a superset of its row's vertices, v included): the rows that can span an edge, without
+// building the others (fit/albedo_deconvolution.h footprint_spans_an_edge then decides on the row).
 struct EdgeFilter {
   const float *rgb = nullptr;
   float contrast = 0;

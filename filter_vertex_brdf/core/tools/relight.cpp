@@ -154,9 +154,9 @@ struct SeenAlbedo {
     const size_t c = size_t(camera_of_raster[r]);
     if (!known[c][v]) return fit;
     VertexFit seen = fit;
-    const float *rho = &rgb[c][3 * v];
-    seen.kd = std::max(rho[0], std::max(rho[1], rho[2]));
-    for (int k = 0; k < 3; ++k) seen.color[k] = seen.kd > 0 ? rho[k] / seen.kd : 0.0f;
+    const float *rgb_v = &rgb[c][3 * v];
+    const double rho[3] = {rgb_v[0], rgb_v[1], rgb_v[2]};
+    set_kd_color(rho, seen);
     return seen;
   }
 };
