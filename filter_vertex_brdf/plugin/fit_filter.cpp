@@ -25,6 +25,7 @@ const char *const kDiffuseTerm = "diffuseTerm";
 const char *const kFindMaterials = "findMaterials";
 const char *const kMaxIterations = "maxIterations";
 const char *const kSharpenAlbedo = "sharpenAlbedoEdges";
+const char *const kRefineRegistration = "refineRegistration";
 const char *const kFillUnseenRings = "fillUnseenRings";
 
 std::string color_summary(const vbrdf::FitSettings &settings, const vbrdf::FitResult &result) {
@@ -127,6 +128,13 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "still reproduces the photos (not where the colour is a texture finer than the "
                            "mesh). Writes per-vertex 'diffuse_deconvolved'; the report says how many. On by "
                            "default."));
+  params.addParam(RichBool(kRefineRegistration, vbrdf::FitSettings().registration.enabled, "Refine registration",
+                           "Each viewpoint's camera is measured against its photos (the normals photometric "
+                           "stereo reads from them, which the light does not change) and, where it is off by "
+                           "more than a quarter pixel, corrected (turn and focal length) before any sample is "
+                           "taken. The corrected cameras are applied to the project's rasters and written to "
+                           "<output>_registered.mlp; the input project is never changed. The report gives each "
+                           "viewpoint's misregistration before and after. Off by default."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
@@ -174,6 +182,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.fill_unseen_rings = fill_rings;
   s.materials = params.getBool(kFindMaterials);
   s.deconvolve_albedo = params.getBool(kSharpenAlbedo);
+  s.registration.enabled = params.getBool(kRefineRegistration);
   s.quality = shared::quality_output(params);
   s.color_correction = shared::color_correction(params);
   s.chart_corners = shared::chart_corners(params);
@@ -222,6 +231,7 @@ void FitFilter::apply(FilterRun &run) const {
     result = vbrdf::run_fit(input, settings, *visibility, fitter.get(), progress_adapter(run.progress, "Vertex BRDF: "),
                             log);
   }
+  apply_corrected_cameras(run.document, result.registration, log);
   StoredResults stored;
   stored.layer = ColorLayer::Fit;
   stored.colors_rgba = std::move(result.colors_rgba);

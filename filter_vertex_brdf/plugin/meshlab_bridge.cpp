@@ -122,6 +122,19 @@ std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document) {
   return rasters;
 }
 
+void apply_corrected_cameras(MeshDocument &document, const vbrdf::RegistrationResult &registration,
+                             const std::function<void(const std::string &)> &log) {
+  if (!registration.any_applied()) return;
+  size_t moved = 0;
+  for (RasterModel *rm : document.rasterList)
+    if (const vbrdf::Shot *corrected = registration.corrected_for(rm->shot)) {
+      rm->shot = *corrected;
+      ++moved;
+    }
+  log("Vertex BRDF: the corrected cameras were applied to " + std::to_string(moved) +
+      " raster(s) of the document (save the project to keep them; the result's _registered.mlp has them too).");
+}
+
 ActiveRasters active_rasters(const MeshDocument &document) {
   ActiveRasters active;
   for (int i = 0; i < document.rasterList.size(); ++i) {

@@ -10,6 +10,7 @@
 #include "core/base/mesh_view.h"
 #include "core/io/output_ply.h"
 #include "core/samples/samples.h"
+#include "core/registration/registration.h"
 
 namespace vbrdf_plugin {
 
@@ -28,6 +29,11 @@ MeshArrays mesh_arrays(const MeshModel &mesh);
 // Every raster of the document with its shot and the path of its first image plane.
 // Throws vbrdf::InputError naming a raster without image.
 std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document);
+
+// Gives every raster of the document (hidden ones too) whose shot is a viewpoint that registration
+// corrected the corrected shot, as MeshLab's own alignment filters move the rasters; logs how many.
+void apply_corrected_cameras(MeshDocument &document, const vbrdf::RegistrationResult &registration,
+                             const std::function<void(const std::string &)> &log);
 
 // The rasters the fit and the coverage use: the visible ones (the eye in MeshLab's layer dialog),
 // as MeshLab's own "Project active rasters color to current mesh" takes them. document_index[i] is

@@ -6,6 +6,7 @@
 //             [--photo-shadows on|off]
 //             [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
 //             [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]
+//             [--registration on|off] [--registration-threshold 0.25]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -36,7 +37,8 @@ int usage() {
                "                 [--min-heldout-photos N]\n"
                "                 [--photo-shadows on|off]\n"
                "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n"
-               "                 [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]\n";
+               "                 [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]\n"
+               "                 [--registration on|off] [--registration-threshold PX]\n";
   return 2;
 }
 } // namespace
@@ -75,6 +77,8 @@ int main(int argc, char **argv) {
     } else if (a == "--resolution-weights") settings.gather.resolution_weights = next() == "on";
     else if (a == "--footprint") settings.gather.footprint = next() == "on";
     else if (a == "--deconvolve") settings.deconvolve_albedo = next() == "on";
+    else if (a == "--registration") settings.registration.enabled = next() == "on";
+    else if (a == "--registration-threshold") settings.registration.threshold_px = std::stof(next());
     else if (a == "--deconvolve-lambda") settings.deconvolution.lambda = std::stof(next());
     else if (a == "--deconvolve-edge") settings.deconvolution.edge_contrast = std::stof(next());
     else if (a == "--deconvolve-misfit") settings.deconvolution.misfit_tolerance = std::stof(next());

@@ -103,6 +103,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("diffuseTerm", EnumValue(1));
   p.setValue("findMaterials", BoolValue(true));
   p.setValue("sharpenAlbedoEdges", BoolValue(false));
+  p.setValue("refineRegistration", BoolValue(true));
   p.setValue("maxIterations", IntValue(7));
   p.setValue("minSpecularSamples", IntValue(3));
   p.setValue("fillUnseenRings", IntValue(4));
@@ -115,6 +116,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_FLOAT_EQ(s.dome_radius, 2.5f);
   EXPECT_FLOAT_EQ(s.light_unit_scale, 10.0f);
   EXPECT_EQ(s.output_ply, "out.ply");
+  EXPECT_TRUE(s.registration.enabled);
   EXPECT_EQ(s.overwrite, vbrdf::OverwritePolicy::Refuse);
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, 0.8f);
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, 0.3f);

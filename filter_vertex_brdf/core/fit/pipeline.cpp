@@ -21,6 +21,7 @@
 #include "fit/diffuse_choice.h"
 #include "samples/footprint.h"
 #include "io/fit_outputs.h"
+#include "io/registered_project.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
 #include "visibility/pass_size.h"
@@ -30,6 +31,10 @@ namespace vbrdf {
 std::string default_output_path(const std::string &project_path) {
   if (project_path.empty()) return "vertex_brdf.ply";
   return strip_extension(project_path) + "_brdf.ply";
+}
+
+std::string registered_project_path(const std::string &output_ply) {
+  return strip_extension(output_ply) + "_registered.mlp";
 }
 
 void validate_input(const FitInput &input) {
@@ -266,9 +271,10 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
 }
 } // namespace
 
-FitResult run_fit(const FitInput &input, const FitSettings &settings_in, VisibilityBackend &visibility,
+FitResult run_fit(const FitInput &given, const FitSettings &settings_in, VisibilityBackend &visibility,
                   PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {
-  validate_input(input);
+  validate_input(given);
+  FitInput input = given;  // its rasters take the corrected cameras (registration), the caller's never change
   FitSettings settings = settings_in;
   settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
   settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
@@ -296,7 +302,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   }
   const LightPlacement placement =
       light_placement_of(mesh, settings.dome_radius, settings.light_unit_scale);
-  const std::vector<LightSource> lights = resolve_lights(input.rasters, result.light_file, placement);
+  std::vector<LightSource> lights = resolve_lights(input.rasters, result.light_file, placement);
   result.light_model = describe_lights(lights, placement);
   log("Lights: " + result.light_model + ", from '" + result.light_file + "'.");
 
@@ -306,6 +312,8 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
       throw InputError("The output '" + result.output_ply + "' would overwrite an input file: choose another 'outputPly'.");
 
   check_output_path(report_path_for(result.output_ply), settings.overwrite, "Output PLY");
+  if (settings.registration.enabled)
+    check_output_path(registered_project_path(result.output_ply), settings.overwrite, "Output PLY");
   result.output_note = check_output_path(result.output_ply, settings.overwrite, "Output PLY");
   result.normals_source = describe_normals_source(input.mesh_path);
   log(result.normals_source + ".");
@@ -315,6 +323,18 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes,
                     settings.gather.host_photos);
   const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);
+  if (settings.registration.enabled) {
+    if (progress && !progress(0.0f, "registration")) throw ProcessingError("cancelled");
+    const auto t_reg = Clock::now();
+    result.registration =
+        refine_registration(mesh, input.rasters, lights, photos, visibility, settings.registration, log);
+    if (result.registration.any_applied()) {
+      input.rasters = result.registration.rasters;
+      result.registered_project = registered_project_path(result.output_ply);
+      lights = resolve_lights(input.rasters, result.light_file, placement);  // .lp directions follow the camera
+    }
+    result.seconds_registration = seconds_since(t_reg);
+  }
   if (progress) progress(0.0f, "colour calibration");
   ColorPlanBesidePasses color_search(input, settings, light_directions(lights), photos);
 
@@ -364,6 +384,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
     log("Vertex BRDF: " + result.memory_note + ".");
   }
   result.warnings = check_photo_contents(input.rasters, contents);
+  result.warnings.insert(result.warnings.end(), result.registration.warnings.begin(), result.registration.warnings.end());
   for (const std::string &w : result.warnings) log(w);
   if (std::all_of(masks.seen_count.begin(), masks.seen_count.end(), [](uint32_t c) { return c == 0; }))
     throw InputError("No raster's camera sees the mesh (every vertex is outside every photo, behind its camera or "
@@ -433,6 +454,13 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
     if (settings.overwrite == OverwritePolicy::Refuse)  // again: another run may have written it meanwhile
       check_output_path(result.output_ply, settings.overwrite, "Output PLY");
     AtomicOutput ply(result.output_ply), report(report_path_for(result.output_ply));
+    std::unique_ptr<AtomicOutput> project;
+    if (result.registration.any_applied()) {
+      project = std::make_unique<AtomicOutput>(result.registered_project);
+      const std::string text =
+          registered_project_text(given.project_path, given.mesh_path, given.rasters, result.registration);
+      stage_text_file(*project, text);
+    }
     stage_result_ply(ply, mesh, result.colors_rgba, result.attributes);
     result.seconds_output = seconds_since(t);
     result.report += "output: " + result.output_ply + " (" + result.output_note + "; written in " +
@@ -440,6 +468,7 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings_in, Visibil
     stage_text_file(report, result.report);
     ply.commit();
     report.commit((long long)result.report.size());
+    if (project) project->commit();
   }
 
   std::istringstream lines(result.report);

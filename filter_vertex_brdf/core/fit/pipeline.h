@@ -23,6 +23,7 @@
 #include "io/output_ply.h"
 #include "samples/samples.h"
 #include "inputs/viewpoints.h"
+#include "registration/registration.h"
 #include "visibility/visibility.h"
 
 namespace vbrdf {
@@ -93,6 +94,10 @@ struct FitSettings {
   // through the same footprints. Phong fit only. On by default since 2026-12-04 (README "Tenth step").
   bool deconvolve_albedo = true;
   DeconvolutionSettings deconvolution;
+  // Each viewpoint's camera measured against its photos and corrected where it is off by more than
+  // the threshold (registration/registration.h); the corrected cameras go into
+  // <ply stem>_registered.mlp beside the result. Off: the cameras as given.
+  RegistrationSettings registration;
 };
 
 struct FitInput {
@@ -115,6 +120,8 @@ struct FitInput {
 void validate_input(const FitInput &input);
 
 struct FitResult {
+  RegistrationResult registration;        // per viewpoint: measured, corrected or why not (empty when off)
+  std::string registered_project;         // the .mlp with the corrected cameras ("" when none was corrected)
   std::vector<DiffuseEstimate> diffuse;   // per vertex
   std::vector<VertexFit> fits;            // per vertex (empty when fit_reflectance is off)
   std::vector<float> quality;             // per vertex, as chosen by FitSettings::quality
@@ -149,7 +156,7 @@ struct FitResult {
   std::string output_note;                // "new file" / "replaces the existing file (N bytes)"
   std::string memory_note;                // a photo larger than the photo memory: how it was handled
   size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;
-  double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0;
+  double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0, seconds_registration = 0;
   // The stages around those (the report's second time line): colour chart search and correction
   // plan (in a thread of its own during the visibility passes, so not on the wall clock's path
   // unless it outlasts them), photo content checks, the diffuse-form pilot, the material stage, the neighbour fill and the albedo deconvolution.
@@ -167,5 +174,8 @@ FitResult run_fit(const FitInput &input, const FitSettings &settings, Visibility
 // Default output path for a project: <folder>/<name>_brdf.ply ("vertex_brdf.ply" in the
 // current folder when no project path is known).
 std::string default_output_path(const std::string &project_path);
+
+// The project with the corrected cameras written beside a result PLY: <ply stem>_registered.mlp.
+std::string registered_project_path(const std::string &output_ply);
 
 } // namespace vbrdf

@@ -129,6 +129,20 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
   r.attributes = result_attributes(records, !r.fits.empty());  // by name, in the schema's file order
 }
 
+namespace {
+// One line per viewpoint: measured misregistration before and after, or why it was not measured.
+std::string registration_report(const FitSettings &settings, const FitResult &r) {
+  if (!settings.registration.enabled) return "registration: off (cameras as given)\n";
+  std::string s = "registration (each viewpoint's camera measured against its photos; corrected above " +
+                  fixed(settings.registration.threshold_px) + " px):\n";
+  for (const ViewpointRegistration &v : r.registration.viewpoints)
+    s += "  " + describe_registration(v, settings.registration) + "\n";
+  s += r.registered_project.empty() ? std::string("  no camera corrected: no registered project written\n")
+                                    : "  corrected cameras: " + r.registered_project + " (the input project is unchanged)\n";
+  return s;
+}
+} // namespace
+
 std::string build_report(const FitInput &input, const FitSettings &settings, const FitResult &r) {
   const MeshView &mesh = input.mesh;
   const size_t n = mesh.vertex_count;
@@ -141,6 +155,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << r.normals_source << "\n"
       << (r.memory_note.empty() ? std::string() : r.memory_note + "\n")
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
+      << registration_report(settings, r)
       << "lights against the photos (predicted irradiance vs brightness): "
       << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
       << "visibility back end: " << r.visibility_backend << "\n"
@@ -221,7 +236,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
       << g.host_photo_reads << " photos read from MeshLab's images, "
       << g.rasters_skipped << " raster x chunk pairs skipped)\n";
-  rep << "time, other stages: colour chart search and correction " << fixed(r.seconds_colors)
+  rep << "time, other stages: registration " << fixed(r.seconds_registration) << " s, colour chart search and correction " << fixed(r.seconds_colors)
       << " s (beside the visibility passes), photo checks "
       << fixed(r.seconds_photo_checks) << " s, diffuse-form pilot " << fixed(r.seconds_pilot) << " s, materials "
       << fixed(r.seconds_materials) << " s, neighbour fill " << fixed(r.seconds_fill) << " s, albedo deconvolution "
