@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "inputs/light_source.h"
+#include "inputs/project.h"
+#include "io/registered_project.h"
 #include "registration/registration.h"
 #include "test_paths.h"
 #include "test_scenes.h"
@@ -236,4 +239,64 @@ TEST(Registration, SaysWhyAViewpointIsNotMeasured) {
   const RegistrationResult f = refine(flat, shifted(flat.truth, 1, 0));
   EXPECT_FALSE(f.viewpoints.at(0).measured);
   EXPECT_NE(f.viewpoints[0].not_measured.find("one plane"), std::string::npos);
+}
+
+// The registered project: the input's own document with the corrected viewpoint's cameras replaced
+// and file names made absolute; the input file is only read (byte for byte the same afterwards).
+TEST(Registration, RegisteredProjectReplacesOnlyTheCorrectedCamerasAndLeavesTheInput) {
+  const std::string folder = test::scratch_dir("registration_project");
+  const float eye[3] = {0, 0, 4}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+  const Shot a = test::make_look_at_shot(eye, target, up, 400.0f, 320, 240);
+  const float eye2[3] = {3, 0, 3};
+  const Shot b = test::make_look_at_shot(eye2, target, up, 400.0f, 320, 240);
+  std::vector<Raster> rasters;
+  for (int i = 0; i < 3; ++i) {
+    Raster r;
+    r.label = "p" + std::to_string(i);
+    r.image_path = folder + "/p" + std::to_string(i) + ".png";
+    r.shot = i < 2 ? a : b;
+    rasters.push_back(r);
+  }
+  RegistrationResult none;
+  const std::string input = registered_project_text("", folder + "/mesh.ply", rasters, none);
+  const std::string input_path = folder + "/project.mlp";
+  {
+    std::FILE *f = std::fopen(input_path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(input.data(), 1, input.size(), f);
+    std::fclose(f);
+  }
+  RegistrationResult r;
+  ViewpointRegistration v;
+  v.applied = true;
+  v.given = a;
+  ImageWarp turn;
+  turn.yaw = 0.002;
+  v.corrected = warped_shot(a, turn);
+  r.viewpoints.push_back(v);
+  const std::string text = registered_project_text(input_path, folder + "/mesh.ply", rasters, r);
+  // The input is unchanged.
+  std::FILE *f = std::fopen(input_path.c_str(), "rb");
+  std::string again(input.size() + 16, '\0');
+  again.resize(std::fread(&again[0], 1, again.size(), f));
+  std::fclose(f);
+  EXPECT_EQ(again, input);
+  // Read back: the two rasters of the corrected viewpoint moved, the third did not.
+  const std::string out_path = folder + "/registered.mlp";
+  f = std::fopen(out_path.c_str(), "wb");
+  std::fwrite(text.data(), 1, text.size(), f);
+  std::fclose(f);
+  const Project p = read_project(out_path);
+  ASSERT_EQ(p.rasters.size(), 3u);
+  EXPECT_EQ(p.mesh_path, folder + "/mesh.ply");
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(p.rasters[size_t(i)].image_path, rasters[size_t(i)].image_path);
+  const float point[3] = {0.2f, 0.1f, 0.3f};
+  for (int i = 0; i < 2; ++i) {
+    const ImagePoint moved = project_to_image(p.rasters[size_t(i)].shot, point);
+    const ImagePoint want = project_to_image(v.corrected, point);
+    EXPECT_NEAR(moved.x, want.x, 0.01);
+    EXPECT_NEAR(moved.y, want.y, 0.01);
+    EXPECT_GT(std::fabs(moved.x - project_to_image(a, point).x), 0.5);
+  }
+  EXPECT_TRUE(same_shot(p.rasters[2].shot, b));
 }
