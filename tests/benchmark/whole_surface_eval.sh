@@ -43,7 +43,9 @@ for scene in $scenes; do
   mkdir -p "$out"
   fit_lights=""
   eval_lights=""
-  if [ -f "$s/lights_world.json" ] && [ "${LIGHT_POSITIONS:-on}" != off ]; then
+  # A lights_world.json of directional lights ("type": "directional") is the .lp's twin: the .lp is used.
+  if [ -f "$s/lights_world.json" ] && [ "${LIGHT_POSITIONS:-on}" != off ] &&
+     ! grep -q '"type": *"directional"' "$s/lights_world.json"; then
     fit_lights="--lp $s/lights_world.json"
     eval_lights="--lp $s/heldout/lights_world.json --training-lp $s/lights_world.json"
     echo "== $scene (point lights at the positions of lights_world.json)"
