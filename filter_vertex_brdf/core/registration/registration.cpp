@@ -142,11 +142,11 @@ AlignmentResult measure(const std::vector<AlignmentPoint> &points, const NormalM
 ViewpointRegistration register_viewpoint(const MeshView &mesh, const std::vector<Raster> &rasters,
                                          const Viewpoint &vp, const std::vector<LightSource> &lights,
                                          PhotoCache &photos, VisibilityBackend &visibility,
-                                         const RegistrationSettings &settings, Shot &corrected) {
+                                         const RegistrationSettings &settings) {
   ViewpointRegistration out;
   out.rasters = vp.rasters;
   out.label = rasters[vp.rasters.front()].label;
-  out.given = out.corrected = corrected = vp.shot;
+  out.given = out.corrected = vp.shot;
   if (vp.rasters.size() < size_t(settings.min_photos)) {
     out.not_measured = "fewer than " + std::to_string(settings.min_photos) + " photos (photometric stereo needs them)";
     return out;
@@ -179,8 +179,6 @@ ViewpointRegistration register_viewpoint(const MeshView &mesh, const std::vector
   lum.clear();
   const AlignmentResult before = measure(points, map, vp.shot, settings.alignment);
   out.points = before.points_used;
-  out.cost_before = before.cost_before;
-  out.cost_after = before.cost_after;
   if (before.points_used < settings.min_vertices) {
     out.not_measured = "the photos determine the normals of " + std::to_string(before.points_used) +
                        " of its vertices (fewer than " + std::to_string(settings.min_vertices) + ")";
@@ -198,7 +196,7 @@ ViewpointRegistration register_viewpoint(const MeshView &mesh, const std::vector
   out.shift_y = before.shift_y;
   out.roll_determined = before.roll_determined;
   out.scale_determined = before.scale_determined;
-  out.corrected = corrected = warped_shot(vp.shot, before.warp);
+  out.corrected = warped_shot(vp.shot, before.warp);
   out.applied = true;
   // Measured again from the corrected camera, against the same normal map.
   double c0[2];
@@ -212,7 +210,7 @@ ViewpointRegistration register_viewpoint(const MeshView &mesh, const std::vector
   }
   AlignmentSettings again = settings.alignment;
   again.levels = {settings.alignment.levels.back()};
-  out.after_px = measure(points, map, corrected, again).rms_px;
+  out.after_px = measure(points, map, out.corrected, again).rms_px;
   return out;
 }
 
@@ -241,12 +239,10 @@ RegistrationResult refine_registration(const MeshView &mesh, const std::vector<R
   RegistrationResult result;
   result.rasters = rasters;
   for (const Viewpoint &vp : group_viewpoints(rasters)) {
-    Shot corrected;
-    result.viewpoints.push_back(
-        register_viewpoint(mesh, rasters, vp, lights, photos, visibility, settings, corrected));
+    result.viewpoints.push_back(register_viewpoint(mesh, rasters, vp, lights, photos, visibility, settings));
     const ViewpointRegistration &v = result.viewpoints.back();
     if (v.applied)
-      for (size_t r : vp.rasters) result.rasters[r].shot = corrected;
+      for (size_t r : vp.rasters) result.rasters[r].shot = v.corrected;
     if (v.too_large) {
       result.warnings.push_back("WARNING: the camera of viewpoint '" + v.label + "' is " + fixed(v.before_px) +
                                 " px off its photos, more than registration refinement corrects (" +

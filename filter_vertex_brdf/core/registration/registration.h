@@ -48,7 +48,6 @@ struct ViewpointRegistration {
   bool measured = false;
   std::string not_measured;     // why, when !measured
   size_t points = 0;            // visible vertices on determined pixels
-  double cost_before = 0, cost_after = 0;  // mean robust cost at the given and the corrected camera
   double before_px = 0;         // measured misregistration at the given camera
   double after_px = 0;          // measured again at the corrected camera (before_px when unchanged)
   ImageWarp correction;         // what was applied (identity when unchanged)

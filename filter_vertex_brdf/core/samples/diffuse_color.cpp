@@ -3,13 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/luminance.h"
+
 namespace vbrdf {
 
 namespace {
-constexpr float kLuma[3] = {0.2126f, 0.7152f, 0.0722f};  // Rec. 709 / sRGB luminance weights
-
-float luminance(const float rgb[3]) { return kLuma[0] * rgb[0] + kLuma[1] * rgb[1] + kLuma[2] * rgb[2]; }
-
 float median(std::vector<float> &v) {
   const size_t mid = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + long(mid), v.end());
