@@ -26,6 +26,7 @@ const char *const kFindMaterials = "findMaterials";
 const char *const kMaxIterations = "maxIterations";
 const char *const kSharpenAlbedo = "sharpenAlbedoEdges";
 const char *const kRefineRegistration = "refineRegistration";
+const char *const kRefineNormals = "refineNormals";
 const char *const kFillUnseenRings = "fillUnseenRings";
 
 std::string color_summary(const vbrdf::FitSettings &settings, const vbrdf::FitResult &result) {
@@ -135,6 +136,14 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "taken. The corrected cameras are applied to the project's rasters and written to "
                            "<output>_registered.mlp; the input project is never changed. The report gives each "
                            "viewpoint's misregistration before and after. Off by default."));
+  params.addParam(RichBool(kRefineNormals, vbrdf::FitSettings().shading_normals.enabled, "Refine normals from photos",
+                           "A scanned mesh is smoother than the surface, its normals a few degrees off. On: each "
+                           "vertex's shading normal is refined from its photos jointly with its reflectance "
+                           "(kept near the mesh normal and its neighbours', and left as the mesh's where the "
+                           "lights do not determine it). Visibility and shadows keep the mesh. The layer's "
+                           "normals and the PLY's nx ny nz become the refined ones (the relight filter and the "
+                           "live view shade with them); the mesh's own normals are kept as mesh_nx/ny/nz. The "
+                           "report says how far they moved. On by default."));
   params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
@@ -183,6 +192,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   s.materials = params.getBool(kFindMaterials);
   s.deconvolve_albedo = params.getBool(kSharpenAlbedo);
   s.registration.enabled = params.getBool(kRefineRegistration);
+  s.shading_normals.enabled = params.getBool(kRefineNormals);
   s.quality = shared::quality_output(params);
   s.color_correction = shared::color_correction(params);
   s.chart_corners = shared::chart_corners(params);
@@ -197,7 +207,10 @@ void FitFilter::apply(FilterRun &run) const {
   const auto log = [&run](const std::string &line) { run.log(GLLogStream::FILTER, line); };
 
   vbrdf::FitSettings settings = settings_from(run.params);
-  const MeshArrays arrays = mesh_arrays(*mesh);
+  MeshArrays arrays = mesh_arrays(*mesh);
+  if (const size_t restored = restore_mesh_normals(*mesh, arrays))
+    log("Vertex BRDF: " + std::to_string(restored) + " vertices start from the mesh's own normals (mesh_nx/ny/nz of "
+        "an earlier fit), not from that fit's refined ones.");
   if (arrays.transformed)
     log("Vertex BRDF: the layer has a transformation matrix; the fit (and the output PLY) use the "
         "transformed, world coordinates in which the rasters are registered.");
@@ -239,6 +252,7 @@ void FitFilter::apply(FilterRun &run) const {
   stored.attributes = std::move(result.attributes);
   stored.vertex_mask = input.vertex_mask;
   store_results(*mesh, arrays, stored);
+  apply_shading_normals(*mesh, arrays, result.shading_normals, input.vertex_mask);
 
   std::ostringstream summary;
   summary << "Vertex BRDF: " << result.vertices_coloured << " of " << arrays.vertex_index.size()

@@ -244,6 +244,46 @@ void store_results(MeshModel &mesh, const MeshArrays &arrays, const StoredResult
   }
 }
 
+void apply_shading_normals(MeshModel &mesh, const MeshArrays &arrays, const std::vector<float> &normals,
+                           const std::vector<uint8_t> &vertex_mask) {
+  CMeshO &cm = mesh.cm;
+  const size_t n = arrays.vertex_index.size();
+  if (normals.size() != 3 * n) return;
+  const bool masked = vertex_mask.size() == n;
+  // World normals back to the layer's frame: the transpose of the linear part undoes the inverse
+  // transpose that mesh_arrays applied.
+  Matrix44m to_local = cm.Tr;
+  to_local.transposeInPlace();
+  for (size_t i = 0; i < n; ++i) {
+    if (masked && !vertex_mask[i]) continue;
+    vcg::Point3f nw(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    if (arrays.transformed) {
+      const vcg::Point4f n4 = to_local * vcg::Point4f(nw[0], nw[1], nw[2], 0.0f);
+      nw = vcg::Point3f(n4[0], n4[1], n4[2]);
+    }
+    if (!(nw.Norm() > 0)) continue;
+    cm.vert[arrays.vertex_index[i]].N() = nw.Normalize();
+  }
+}
+
+size_t restore_mesh_normals(MeshModel &mesh, MeshArrays &arrays) {
+  CMeshO &cm = mesh.cm;
+  using Alloc = vcg::tri::Allocator<CMeshO>;
+  auto x = Alloc::FindPerVertexAttribute<float>(cm, "mesh_nx");
+  auto y = Alloc::FindPerVertexAttribute<float>(cm, "mesh_ny");
+  auto z = Alloc::FindPerVertexAttribute<float>(cm, "mesh_nz");
+  if (!Alloc::IsValidHandle(cm, x) || !Alloc::IsValidHandle(cm, y) || !Alloc::IsValidHandle(cm, z)) return 0;
+  size_t restored = 0;
+  for (size_t i = 0; i < arrays.vertex_index.size(); ++i) {
+    const size_t v = arrays.vertex_index[i];
+    const float n[3] = {x[v], y[v], z[v]};
+    if (!(n[0] != 0 || n[1] != 0 || n[2] != 0) || !std::isfinite(n[0] + n[1] + n[2])) continue;
+    for (int k = 0; k < 3; ++k) arrays.data.normals[3 * i + size_t(k)] = n[k];
+    ++restored;
+  }
+  return restored;
+}
+
 bool show_color_layer(MeshModel &mesh, ColorLayer layer) {
   CMeshO &cm = mesh.cm;
   const char *name = color_layer_attribute(layer);

@@ -83,6 +83,16 @@ struct StoredResults {
 // Stores `results` in the mesh (enabling the colour and quality attributes as needed). The input
 // colours are saved before the first paint.
 void store_results(MeshModel &mesh, const MeshArrays &arrays, const StoredResults &results);
+// The fit's shading normals (3 per array vertex, world frame; empty: none) become the layer's vertex
+// normals (in its own frame), so that the relight filter and the live view shade with them; the
+// mesh's own normals stay in the result's mesh_nx/ny/nz attributes. Only masked-in vertices change.
+void apply_shading_normals(MeshModel &mesh, const MeshArrays &arrays, const std::vector<float> &normals,
+                           const std::vector<uint8_t> &vertex_mask);
+// Where an earlier fit left the mesh's own normals in mesh_nx/ny/nz (world frame), the arrays take
+// them back, so that a fit always starts from the scan's normals, not from an earlier refinement.
+// Returns the number of vertices restored.
+size_t restore_mesh_normals(MeshModel &mesh, MeshArrays &arrays);
+
 // Copies the colour layer onto the vertex colours. False (mesh unchanged) when the mesh has no
 // such layer. The input layer, when never saved, is the current colours: nothing to do, true.
 bool show_color_layer(MeshModel &mesh, ColorLayer layer);

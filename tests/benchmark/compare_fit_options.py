@@ -38,11 +38,12 @@ def main():
     ap.add_argument('--photos', type=int, default=0)
     ap.add_argument('--backend', default='cpu')
     ap.add_argument('--against', required=True, help='extra vbrdf_bench options of the fit to beat')
+    ap.add_argument('--base', default='', help='vbrdf_bench options of both fits (the stage under test alone)')
     ap.add_argument('--min-gain', type=float, default=0.0)
     ap.add_argument('--work', required=True)
     args = ap.parse_args()
-    ours = fit(args, 'defaults', [])
-    other = fit(args, 'against', shlex.split(args.against))
+    ours = fit(args, 'defaults', shlex.split(args.base))
+    other = fit(args, 'against', shlex.split(args.base) + shlex.split(args.against))
     for name, r in (('defaults', ours), (args.against, other)):
         print(f"{name:28s} relit mean / p95 {r['relit_mean']:.3f} / {r['relit_p95']:.2f}, "
               f"whole surface {r['ws_mean']:.3f} / {r['ws_p95']:.2f}")

@@ -1,17 +1,21 @@
 #!/usr/bin/env python3
-"""Relighting with the cameras a real registration gives: each shared scene fitted from a copy of its
+"""Relighting with the inputs a real capture gives: each shared scene fitted from a copy of its
 project whose cameras are off (perturb_cameras.py: principal point shifted by 1 and 2 px, camera
-turned 0.2 deg), with registration refinement on and off, and scored on the held-out photos with the
+turned 0.2 deg) or whose mesh normals are smoothed as a scan's are (vbrdf_perturb_mesh: 1-ring
+averaging until they are 3.5 deg off in median), with the step that corrects it (registration
+refinement, shading normals from the photos) off and on, and scored on the held-out photos with the
 exact cameras over the whole visible surface (vbrdf_eval, the RTI protocol), beside per-pixel PTM and
-RBF fitted on the same training photos (per pixel: no camera, so no registration error).
+RBF fitted on the same training photos (per pixel: no camera and no mesh, so neither error).
 
   imperfect_captures.py [--build build/release] [--work DIR] [--scenes spot_dir24 ...] [--csv FILE]
-                        [--max-ratio 1.10]
+                        [--captures exact "shift 1 px" ...] [--max-ratio 1.10]
 
-Prints one row per scene x capture x registration: relit CIEDE2000 mean / p95, PTM and RBF on the
-same samples, the misregistration the fit measured and the fit's run time. --max-ratio: exit 1 unless
-every perturbed capture with registration on is within that ratio of the exact capture's mean and
-p95 and below PTM and RBF in both. Skips (exit 0) without the shared scenes.
+Prints one row per scene x capture x correction: relit CIEDE2000 mean / p95, PTM and RBF on the
+same samples, the misregistration the fit measured (camera captures) or how far the normals moved
+(median degrees), and the fit's run time. The exact capture runs with both steps on (the product).
+--max-ratio: exit 1 unless every perturbed capture with its correction on is within that ratio of
+the exact capture's mean and p95 and below PTM and RBF in both. Skips (exit 0) without the shared
+scenes.
 """
 import argparse
 import csv
@@ -23,13 +27,15 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
-CAPTURES = [  # name, perturb_cameras.py arguments
-    ("exact", []),
-    ("shift 1 px", ["--shift", "0.8", "-0.6"]),
-    ("shift 2 px", ["--shift", "1.6", "1.2"]),
-    ("yaw 0.2 deg", ["--rotate", "y", "0.2"]),
-    ("roll 0.2 deg", ["--rotate", "z", "0.2"]),
+CAPTURES = [  # name, perturb_cameras.py arguments, vbrdf_perturb_mesh arguments, the step that corrects it
+    ("exact", [], [], None),
+    ("shift 1 px", ["--shift", "0.8", "-0.6"], [], "registration"),
+    ("shift 2 px", ["--shift", "1.6", "1.2"], [], "registration"),
+    ("yaw 0.2 deg", ["--rotate", "y", "0.2"], [], "registration"),
+    ("roll 0.2 deg", ["--rotate", "z", "0.2"], [], "registration"),
+    ("normals smoothed", [], ["--smooth-normals", "3", "--target-median", "3.5"], "shading-normals"),
 ]
+STEP_DEFAULTS = {"registration": "off", "shading-normals": "on"}  # the other step, as the product runs
 
 
 def run(cmd, log):
@@ -87,43 +93,57 @@ def main():
     os.makedirs(work, exist_ok=True)
     captures = [c for c in CAPTURES if not args.captures or c[0] in args.captures]
     rows, failures = [], []
-    print(f"{'scene':28} {'capture':14} {'registration':12} {'mean':>6} {'p95':>6}   {'PTM':>13} {'RBF':>13}  measured  fit s")
+    print(f"{'scene':28} {'capture':16} {'correction':19} {'mean':>6} {'p95':>6}   {'PTM':>13} {'RBF':>13}  {'measured':>14}  fit s")
     for scene in args.scenes:
         s = os.path.join(shared, "scenes", scene)
         lit = gt_lit(s, os.path.join(work, scene + "_gt_lit.txt"))
         exact = None
-        for name, perturb in captures:
+        for name, perturb, mesh_args, step in captures:
             tag = scene + "_" + name.replace(" ", "_").replace(".", "")
             project = os.path.join(s, "project.mlp")
+            moved_mesh = ""
+            if mesh_args:
+                mesh = os.path.join(work, tag + ".ply")
+                out = subprocess.run([os.path.join(args.build, "tests", "benchmark", "vbrdf_perturb_mesh"),
+                                      os.path.join(s, "mesh.ply"), mesh] + mesh_args,
+                                     check=True, capture_output=True, text=True).stdout
+                m = re.search(r"median ([\d.]+) deg, p95 ([\d.]+) deg", out)
+                moved_mesh = f"{m.group(1)}/{m.group(2)} deg" if m else ""
+                perturb = perturb + ["--mesh", mesh]
             if perturb:
                 project = os.path.join(work, tag + ".mlp")
                 subprocess.check_call([sys.executable, os.path.join(HERE, "perturb_cameras.py"),
                                        os.path.join(s, "project.mlp"), project] + perturb)
-            for reg in (["on"] if not perturb else ["off", "on"]):
-                out = os.path.join(work, f"{tag}_reg{reg}.ply")
+            for setting in (["on"] if not step else ["off", "on"]):
+                steps = dict(STEP_DEFAULTS, registration="on") if not step else dict(STEP_DEFAULTS, **{step: setting})
+                out = os.path.join(work, f"{tag}_{step or 'both'}{setting}.ply")
                 rc, secs = run([fit, project, "--lp", os.path.join(s, "lights.lp"), "--photo-dir", os.path.join(s, "linear"),
-                                "--color-correction", "off", "--registration", reg, "--out", out], out + ".fit.log")
+                                "--color-correction", "off", "--registration", steps["registration"],
+                                "--shading-normals", steps["shading-normals"], "--out", out], out + ".fit.log")
                 if rc != 0:
                     failures.append(f"{scene} {name}: vbrdf_fit failed (see {out}.fit.log)")
                     continue
-                measured = ""
-                m = re.search(r"misregistration ([\d.]+) px", open(out + ".fit.log").read())
-                if m:
-                    measured = m.group(1)
+                log = open(out + ".fit.log").read()
+                m = re.search(r"misregistration ([\d.]+) px", log)
+                measured = m.group(1) + " px" if m and step != "shading-normals" else ""
+                m = re.search(r"Shading normals: refined .*?median ([\d.]+) deg, p95 ([\d.]+) deg", log)
+                if step == "shading-normals" and m and setting == "on":
+                    measured = f"{m.group(1)}/{m.group(2)} deg"
                 rc, _ = run([ev, "--result", out, "--project", os.path.join(s, "heldout", "project.mlp"),
                              "--photo-dir", os.path.join(s, "heldout", "linear"), "--training", os.path.join(s, "project.mlp"),
                              "--training-photo-dir", os.path.join(s, "linear"), "--gt-visible", os.path.join(s, "gt_vertex.ply")] + lit,
                             out + ".eval.log")
                 e = parse_eval(open(out + ".eval.log").read())
-                r = dict(scene=scene, capture=name, registration=reg, mean=e["product"][0], p95=e["product"][1],
+                label = "both on" if not step else f"{step} {setting}"
+                r = dict(scene=scene, capture=name, correction=label, mean=e["product"][0], p95=e["product"][1],
                          ptm_mean=e["ptm"][0], ptm_p95=e["ptm"][1], rbf_mean=e["rbf"][0], rbf_p95=e["rbf"][1],
-                         measured_px=measured, fit_seconds=round(secs, 2))
+                         measured=measured, mesh_normals_off=moved_mesh, fit_seconds=round(secs, 2))
                 rows.append(r)
-                print(f"{scene:28} {name:14} {reg:12} {r['mean']:6.3f} {r['p95']:6.3f}   {r['ptm_mean']:5.3f} / {r['ptm_p95']:5.3f}"
-                      f" {r['rbf_mean']:5.3f} / {r['rbf_p95']:5.3f}  {measured:>8}  {secs:5.1f}", flush=True)
-                if not perturb:
+                print(f"{scene:28} {name:16} {label:19} {r['mean']:6.3f} {r['p95']:6.3f}   {r['ptm_mean']:5.3f} / {r['ptm_p95']:5.3f}"
+                      f" {r['rbf_mean']:5.3f} / {r['rbf_p95']:5.3f}  {measured:>14}  {secs:5.1f}", flush=True)
+                if not step:
                     exact = r
-                elif reg == "on" and args.max_ratio and exact:
+                elif setting == "on" and args.max_ratio and exact:
                     for k in ("mean", "p95"):
                         if r[k] > args.max_ratio * exact[k]:
                             failures.append(f"{scene} {name}: {k} {r[k]:.3f} above {args.max_ratio} x exact {exact[k]:.3f}")

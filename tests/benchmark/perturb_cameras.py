@@ -4,7 +4,9 @@ raster's principal point moved by (dx, dy) image pixels (x right, y down) and/or
 by a small angle about its own x (pitch), y (yaw) or z (roll, the optical axis) axis. File names
 become absolute, so the copy may live anywhere; the input project is only read.
 
-  perturb_cameras.py in.mlp out.mlp [--shift DX DY] [--rotate AXIS DEGREES]
+  perturb_cameras.py in.mlp out.mlp [--shift DX DY] [--rotate AXIS DEGREES] [--mesh PLY]
+
+--mesh: the project's mesh replaced by PLY (a perturbed copy of it: vbrdf_perturb_mesh).
 """
 import argparse
 import math
@@ -31,6 +33,7 @@ def main():
     ap.add_argument("output")
     ap.add_argument("--shift", nargs=2, type=float, default=(0.0, 0.0), metavar=("DX", "DY"))
     ap.add_argument("--rotate", nargs=2, default=None, metavar=("AXIS", "DEGREES"))
+    ap.add_argument("--mesh", default=None)
     args = ap.parse_args()
     if os.path.abspath(args.input) == os.path.abspath(args.output):
         sys.exit("perturb_cameras.py: the output would overwrite the input project")
@@ -38,7 +41,7 @@ def main():
     folder = os.path.dirname(os.path.abspath(args.input))
     root = tree.getroot()
     for mesh in root.iter("MLMesh"):
-        mesh.set("filename", os.path.join(folder, mesh.get("filename")))
+        mesh.set("filename", os.path.abspath(args.mesh) if args.mesh else os.path.join(folder, mesh.get("filename")))
     for raster in root.iter("MLRaster"):
         for plane in raster.iter("Plane"):
             plane.set("fileName", os.path.join(folder, plane.get("fileName")))

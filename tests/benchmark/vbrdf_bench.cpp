@@ -5,6 +5,7 @@
 //                   [--backend gpu|cpu|cpu-all] [--iterations N] [--heldout H.mlp [--heldout-lp L]
 //                   [--heldout-photo-dir D]] [--gt GT.ply [--albedo-factors f0,f1,...]] --work DIR
 //                   [--relight-dir DIR] [--name NAME] [--materials on|off] [--min-heldout-photos N]
+//                   [--shading-normals on|off]
 //       One configuration: runs the filter's pipeline (run_fit) timed per stage, then scores it:
 //       held-out relit error in image space (relight_render.h; the held-out photos colour-corrected
 //       from their chart as the fit corrects its samples) and the parameter error against a ground
@@ -344,6 +345,10 @@ FitSettings settings_for(const Args &a, const std::string &work, const std::stri
   const std::string materials = a.get("materials", s.materials ? "on" : "off");
   if (materials != "on" && materials != "off") throw InputError("--materials must be on or off (got '" + materials + "')");
   s.materials = materials == "on";
+  const std::string normals = a.get("shading-normals", s.shading_normals.enabled ? "on" : "off");
+  if (normals != "on" && normals != "off") throw InputError("--shading-normals must be on or off (got '" + normals + "')");
+  s.shading_normals.enabled = normals == "on";
+  if (!a.get("normal-min-gain").empty()) s.shading_normals.min_gain = std::stof(a.get("normal-min-gain"));
   if (!a.get("min-heldout-photos").empty()) s.material_options.min_heldout_photos = size_t(std::stoul(a.get("min-heldout-photos")));
   s.light_file = lp;
   s.output_ply = join_path(work, "fit.ply");
@@ -401,8 +406,11 @@ int cmd_fit(const Args &a) {
   out.num("diffuse_only_fits", double(r.fit_diffuse_only));
   out.num("converged", double(r.fit_converged));
   out.num("alpha_iterations", double(r.fit_iterations));
+  out.num("t_normals", r.seconds_normals);
+  MeshData shaded = mesh;  // the model is evaluated with the normals it was fitted with (the PLY's nx ny nz)
+  if (r.shading_normals.size() == shaded.normals.size()) shaded.normals = r.shading_normals;
   if (!a.get("heldout").empty())
-    evaluate_heldout(a, mesh, r.fits, settings.phong.lobe, r.diffuse_forms, r.albedo_deconvolved, input.rasters,
+    evaluate_heldout(a, shaded, r.fits, settings.phong.lobe, r.diffuse_forms, r.albedo_deconvolved, input.rasters,
                      resolve_lights(input.rasters, r.light_file,
                                     light_placement_of(mesh.view(), 0.0f, 0.0f)),
                      get_proc, out);

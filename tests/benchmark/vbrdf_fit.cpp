@@ -7,6 +7,7 @@
 //             [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
 //             [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]
 //             [--registration on|off] [--registration-threshold 0.25]
+//             [--shading-normals on|off] [--normal-prior DEG] [--normal-neighbours DEG] [--normal-rounds N] [--normal-highlights on|off] [--normal-min-gain G]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
 // --photo-dir: take each raster's photo (same file name) from DIR instead (e.g. 16-bit linear/).
@@ -38,7 +39,8 @@ int usage() {
                "                 [--photo-shadows on|off]\n"
                "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n"
                "                 [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]\n"
-               "                 [--registration on|off] [--registration-threshold PX]\n";
+               "                 [--registration on|off] [--registration-threshold PX]\n"
+               "                 [--shading-normals on|off] [--normal-prior DEG] [--normal-neighbours DEG] [--normal-rounds N] [--normal-highlights on|off] [--normal-min-gain G]\n";
   return 2;
 }
 } // namespace
@@ -79,6 +81,12 @@ int main(int argc, char **argv) {
     else if (a == "--deconvolve") settings.deconvolve_albedo = next() == "on";
     else if (a == "--registration") settings.registration.enabled = next() == "on";
     else if (a == "--registration-threshold") settings.registration.threshold_px = std::stof(next());
+    else if (a == "--shading-normals") settings.shading_normals.enabled = next() == "on";
+    else if (a == "--normal-prior") settings.shading_normals.mesh_normal_degrees = std::stof(next());
+    else if (a == "--normal-neighbours") settings.shading_normals.neighbour_degrees = std::stof(next());
+    else if (a == "--normal-rounds") settings.shading_normals.rounds = std::stoi(next());
+    else if (a == "--normal-min-gain") settings.shading_normals.min_gain = std::stof(next());
+    else if (a == "--normal-highlights") settings.shading_normals.use_highlights = next() == "on";
     else if (a == "--deconvolve-lambda") settings.deconvolution.lambda = std::stof(next());
     else if (a == "--deconvolve-edge") settings.deconvolution.edge_contrast = std::stof(next());
     else if (a == "--deconvolve-misfit") settings.deconvolution.misfit_tolerance = std::stof(next());

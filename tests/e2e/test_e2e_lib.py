@@ -132,7 +132,7 @@ class ScriptTest(unittest.TestCase):
                  "diffuseThreshold": "RichFloat", "photoEncoding": "RichEnum", "saturationLevel": "RichFloat",
                  "visibilityBackend": "RichEnum", "depthTolerance": "RichFloat", "shadowMapSize": "RichInt",
                  "memoryBudgetMB": "RichInt", "fitReflectance": "RichBool", "fitBackend": "RichEnum",
-                 "initialShininess": "RichFloat", "specularLobe": "RichEnum", "diffuseTerm": "RichEnum", "findMaterials": "RichBool", "sharpenAlbedoEdges": "RichBool", "refineRegistration": "RichBool", "maxIterations": "RichInt", "minSpecularSamples": "RichInt", "fillUnseenRings": "RichInt",
+                 "initialShininess": "RichFloat", "specularLobe": "RichEnum", "diffuseTerm": "RichEnum", "findMaterials": "RichBool", "sharpenAlbedoEdges": "RichBool", "refineRegistration": "RichBool", "refineNormals": "RichBool", "maxIterations": "RichInt", "minSpecularSamples": "RichInt", "fillUnseenRings": "RichInt",
                  "qualityOutput": "RichEnum", "colorCorrection": "RichEnum", "chartCorners": "RichString",
                  "exposureNormalisation": "RichEnum", "onlySelectedVertices": "RichBool"}
         self.assertEqual({n: p.get("type") for n, p in params.items()}, types)

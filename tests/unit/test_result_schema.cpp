@@ -59,7 +59,7 @@ TEST(ResultSchema, FileFormatIsTheDocumentedOne) {
       "float n_specular", "float coloured", "float kd", "float ks", "float shininess", "float color_r",
       "float color_g", "float color_b", "float dq", "float sq", "float fit_rmse", "float fit_status",
       "float fit_iterations", "float material", "float lobe_form", "float diffuse_form",
-      "float diffuse_deconvolved"};
+      "float diffuse_deconvolved", "float mesh_nx", "float mesh_ny", "float mesh_nz", "float normal_moved"};
   const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
   const size_t n = mesh.positions.size() / 3;
   const std::string dir = test::scratch_dir("schema_format");

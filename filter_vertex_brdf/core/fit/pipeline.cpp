@@ -13,6 +13,7 @@
 #include "base/file_util.h"
 #include "inputs/mesh_file.h"
 #include "inputs/photo_content.h"
+#include "base/mesh_adjacency.h"
 #include "base/vec3.h"
 #include "calibration/color_plan.h"
 #include "inputs/light_file.h"
@@ -24,6 +25,7 @@
 #include "io/registered_project.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
+#include "samples/reshade.h"
 #include "visibility/pass_size.h"
 
 namespace vbrdf {
@@ -135,18 +137,16 @@ private:
 };
 
 
-// Everything the chunk consumer produces, per vertex.
-void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options,
-                   const PhotoShadowSettings &photo_shadows, FitResult &r, double &fit_seconds) {
-  r.rim_samples_demoted += prefer_clean_samples(chunk);
-  estimate_diffuse_chunk(chunk, &r.diffuse[chunk.first_vertex]);
-  if (!fitter) return;
-  const auto t = Clock::now();
-  fitter->fit_chunk(chunk, options, &r.fits[chunk.first_vertex]);
+// The chunk's reflectance from its samples as they are shaded now: the back end's fit, the robust
+// basic colour for diffuse-only vertices, and the fallback fit where the strict rules left nothing.
+// diffuse[i] and fits[i] belong to chunk vertex i.
+void fit_chunk_models(SampleChunk &chunk, PhongFitter &fitter, const PhongFitOptions &options,
+                      const DiffuseEstimate *diffuse, VertexFit *fits) {
+  fitter.fit_chunk(chunk, options, fits);
   // Diffuse-only vertices take the robust basic colour (outlier rejection) when it is clean.
   for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
-    VertexFit &f = r.fits[chunk.first_vertex + i];
-    const DiffuseEstimate &e = r.diffuse[chunk.first_vertex + i];
+    VertexFit &f = fits[i];
+    const DiffuseEstimate &e = diffuse[i];
     if (f.status == kFitDiffuseOnly && e.valid && !e.from_mixed_pixels)
       set_diffuse_only_reflectance(chunk.samples.data() + chunk.offsets[i], chunk.offsets[i + 1] - chunk.offsets[i],
                                    options, e.rgb, f);
@@ -155,10 +155,66 @@ void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOption
   // from what there is, on the CPU for either back end (few vertices, and one code path).
 #pragma omp parallel for schedule(dynamic, 64)
   for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
-    VertexFit &f = r.fits[chunk.first_vertex + size_t(i)];
+    VertexFit &f = fits[size_t(i)];
     const uint32_t begin = chunk.offsets[size_t(i)], end = chunk.offsets[size_t(i) + 1];
     if (f.status == kFitNone && end > begin) fit_vertex_weak(chunk.samples.data() + begin, end - begin, options, f);
   }
+}
+
+// The diffuse estimate and reflectance again at the chunk's vertices with selected[i] (their
+// samples shaded anew), the others left as they are: those vertices' samples are copied into a
+// chunk of their own, fitted, and the results put back.
+void refit_selected(const SampleChunk &chunk, const std::vector<uint8_t> &selected, PhongFitter &fitter,
+                    const PhongFitOptions &options, FitResult &r) {
+  SampleChunk part;
+  std::vector<uint32_t> index;
+  part.first_vertex = chunk.first_vertex;
+  part.offsets.push_back(0);
+  for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
+    if (!selected[i]) continue;
+    index.push_back(i);
+    part.samples.insert(part.samples.end(), chunk.samples.begin() + chunk.offsets[i],
+                        chunk.samples.begin() + chunk.offsets[i + 1]);
+    part.offsets.push_back(uint32_t(part.samples.size()));
+  }
+  part.vertex_count = uint32_t(index.size());
+  if (index.empty()) return;
+  std::vector<DiffuseEstimate> diffuse(index.size());
+  std::vector<VertexFit> fits(index.size());
+  estimate_diffuse_chunk(part, diffuse.data());
+  fit_chunk_models(part, fitter, options, diffuse.data(), fits.data());
+  for (size_t k = 0; k < index.size(); ++k) {
+    r.diffuse[chunk.first_vertex + index[k]] = diffuse[k];
+    r.fits[chunk.first_vertex + index[k]] = fits[k];
+  }
+}
+
+// Refines a chunk's shading normals from its fits and shades the samples of those that moved
+// again (shading_normals.h): `active` (null: every vertex) limits it to the vertices still moving;
+// `moved` says which moved. False when none did.
+using NormalStep = std::function<bool(SampleChunk &, const uint8_t *active, std::vector<uint8_t> &moved)>;
+
+// Everything the chunk consumer produces, per vertex. `refine_normals` (may be empty): up to
+// `normal_rounds` alternations of a normal step and a refit of the vertices whose normal moved;
+// a vertex whose normal stopped moving is not solved or fitted again.
+void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options,
+                   const PhotoShadowSettings &photo_shadows, const NormalStep &refine_normals, int normal_rounds,
+                   FitResult &r, double &fit_seconds) {
+  r.rim_samples_demoted += prefer_clean_samples(chunk);
+  estimate_diffuse_chunk(chunk, &r.diffuse[chunk.first_vertex]);
+  if (!fitter) return;
+  auto t = Clock::now();
+  fit_chunk_models(chunk, *fitter, options, &r.diffuse[chunk.first_vertex], &r.fits[chunk.first_vertex]);
+  fit_seconds += seconds_since(t);
+  std::vector<uint8_t> moved, active;
+  for (int round = 0; round < normal_rounds && refine_normals; ++round) {
+    if (!refine_normals(chunk, round == 0 ? nullptr : active.data(), moved)) break;
+    t = Clock::now();
+    refit_selected(chunk, moved, *fitter, options, r);
+    fit_seconds += seconds_since(t);
+    active.swap(moved);
+  }
+  t = Clock::now();
   refit_photo_shadows(chunk, options, photo_shadows, &r.fits[chunk.first_vertex], r.photo_shadow_samples,
                       r.photo_shadow_vertices);
   fit_seconds += seconds_since(t);
@@ -268,6 +324,81 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
     log("Vertex BRDF: diffuse term " + result.diffuse_choice_note + ".");
   }
   settings.gather.diffuse = result.diffuse_forms;
+}
+} // namespace
+
+namespace {
+// The chunk consumer's normal step (shading_normals.h): refine the chunk's normals from its fits,
+// then shade its samples again with them (samples/reshade.h). Keeps the normals in result.
+NormalStep shading_normal_refiner(const FitInput &input, const std::vector<LightSource> &lights,
+                                  const FitSettings &settings, FitResult &result) {
+  const MeshView &mesh = input.mesh;
+  result.shading_normals.assign(mesh.normals, mesh.normals + 3 * mesh.vertex_count);
+  result.normal_moved.assign(mesh.vertex_count, -1.0f);
+  auto adjacency = std::make_shared<const MeshAdjacency>(build_mesh_adjacency(mesh));
+  return [&input, &lights, &settings, &result, adjacency](SampleChunk &chunk, const uint8_t *active,
+                                                           std::vector<uint8_t> &moved) {
+    const auto t = Clock::now();
+    moved.assign(chunk.vertex_count, 0);
+    const ShadingNormalCounts counts = refine_shading_normals(
+        chunk, input.mesh, *adjacency, input.rasters, lights, settings.gather.diffuse, settings.phong.lobe,
+        &result.fits[chunk.first_vertex], settings.shading_normals, active, result.shading_normals.data(),
+        result.normal_moved.data(), moved.data());
+    if (!active) {  // the first round decides which vertices the photos determine
+      result.shading_normal_counts.refined += counts.refined;
+      result.shading_normal_counts.undetermined += counts.undetermined;
+    }
+    const bool any = std::any_of(moved.begin(), moved.end(), [](uint8_t c) { return c != 0; });
+    if (any) {
+      std::vector<float> gradients;  // the footprints see the refined normals' variation
+      if (settings.gather.footprint && settings.gather.lobe == LobeForm::GgxNH) {
+        MeshView shaded = input.mesh;
+        shaded.normals = result.shading_normals.data();
+        gradients = normal_gradients(shaded);
+      }
+      reshade_chunk(chunk, input.mesh, result.shading_normals.data(), moved.data(), input.rasters, lights,
+                    settings.gather, gradients.empty() ? nullptr : gradients.data());
+    }
+    result.seconds_normals += seconds_since(t);
+    return any;
+  };
+}
+
+// The report's and log's account of the shading normals: how many the photos determined and how
+// far they moved from the mesh's, over the mesh and per viewpoint (the vertices its photos see).
+void summarise_shading_normals(const FitInput &input, const VisibilityMasks &masks, const FitSettings &settings,
+                               const LogFn &log, FitResult &result) {
+  const ShadingNormalCounts &c = result.shading_normal_counts;
+  if (c.refined == 0) {
+    result.shading_normals.clear();  // nothing moved: the mesh's normals are the shading normals
+    result.shading_normal_note = "not refined: no vertex's samples determine its normal (" +
+                                 std::to_string(c.undetermined) + " modelled vertices keep the mesh normal)";
+    log("Shading normals: " + result.shading_normal_note + ".");
+    return;
+  }
+  const MovedSummary all = summarise_moved(result.normal_moved);
+  std::string note = "refined from the photos at " + std::to_string(c.refined) + " vertices (moved from the mesh "
+                     "normal: median " + fixed(all.median) + " deg, p95 " + fixed(all.p95) + " deg); " +
+                     std::to_string(c.undetermined) + " modelled vertices keep the mesh normal (fewer than " +
+                     std::to_string(settings.shading_normals.min_samples) + " usable samples, or lights that do not "
+                     "determine it); prior " + fixed(settings.shading_normals.mesh_normal_degrees, 1) + " deg";
+  const std::vector<std::vector<size_t>> viewpoints = rasters_by_viewpoint(input.rasters);
+  if (viewpoints.size() > 1)
+    for (size_t k = 0; k < viewpoints.size(); ++k) {
+      std::vector<uint8_t> seen(input.mesh.vertex_count, 0);
+      for (size_t v = 0; v < seen.size(); ++v)
+        for (size_t r : viewpoints[k])
+          if (masks.is_seen(r, v)) {
+            seen[v] = 1;
+            break;
+          }
+      const MovedSummary s = summarise_moved(result.normal_moved, seen);
+      note += "\n  viewpoint " + std::to_string(k + 1) + " ('" + input.rasters[viewpoints[k].front()].label +
+              "'): " + std::to_string(s.count) + " vertices refined, median " + fixed(s.median) + " deg, p95 " +
+              fixed(s.p95) + " deg";
+    }
+  result.shading_normal_note = note;
+  log("Shading normals: " + note + ".");
 }
 } // namespace
 
@@ -414,18 +545,22 @@ FitResult run_fit(const FitInput &given, const FitSettings &settings_in, Visibil
   const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
   const bool with_materials = settings.fit_reflectance && settings.materials;  // material stage hook (issue 16)
   MaterialSampleStore material_samples(with_materials ? mesh.vertex_count : 0);
+  const NormalStep refine_normals = settings.fit_reflectance && settings.shading_normals.enabled
+                                        ? shading_normal_refiner(input, lights, settings, result)
+                                        : NormalStep();
   result.gather = gather_samples(
       mesh, input.rasters, lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
         if (correct) correct_samples(colors, chunk);
         agreement.add(chunk, mesh, lights);
         apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
-        consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, settings.photo_shadows, result,
-                      result.seconds_fit);
+        consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, settings.photo_shadows,
+                      refine_normals, settings.shading_normals.rounds, result, result.seconds_fit);
         if (with_materials) material_samples.add_chunk(chunk, &result.fits[chunk.first_vertex], settings.phong);
       },
       gather_progress);
   result.seconds_gather = seconds_since(t);
+  if (refine_normals) summarise_shading_normals(input, masks, settings, log, result);
   result.light_agreement = weakest_light_agreement(agreement, input.rasters);
   check_light_agreement(agreement, input.rasters, result.light_file);  // before anything is written
   result.colors = std::move(colors.viewpoints);
@@ -461,7 +596,9 @@ FitResult run_fit(const FitInput &given, const FitSettings &settings_in, Visibil
           registered_project_text(given.project_path, given.mesh_path, given.rasters, result.registration);
       stage_text_file(*project, text);
     }
-    stage_result_ply(ply, mesh, result.colors_rgba, result.attributes);
+    MeshView shaded = mesh;  // the geometry as given, with the normals the model was fitted with
+    if (!result.shading_normals.empty()) shaded.normals = result.shading_normals.data();
+    stage_result_ply(ply, shaded, result.colors_rgba, result.attributes);
     result.seconds_output = seconds_since(t);
     result.report += "output: " + result.output_ply + " (" + result.output_note + "; written in " +
                      fixed(result.seconds_output) + " s)\n";

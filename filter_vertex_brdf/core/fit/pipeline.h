@@ -18,6 +18,7 @@
 #include "fit/phong_fit.h"
 #include "fit/materials.h"
 #include "fit/photo_shadows.h"
+#include "fit/shading_normals.h"
 #include "base/mesh_view.h"
 #include "io/output_file.h"
 #include "io/output_ply.h"
@@ -98,6 +99,12 @@ struct FitSettings {
   // the threshold (registration/registration.h); the corrected cameras go into
   // <ply stem>_registered.mlp beside the result. Off: the cameras as given.
   RegistrationSettings registration;
+  // Each vertex's shading normal refined from its samples, jointly with its reflectance
+  // (fit/shading_normals.h): fit with the mesh's normals, refine, shade the samples again, fit
+  // again. Visibility and shadows keep the mesh. The PLY's nx ny nz are the refined normals
+  // (mesh_nx ny nz keep the mesh's). Phong fit only; vertices the samples do not determine keep
+  // the mesh normal.
+  ShadingNormalSettings shading_normals;
 };
 
 struct FitInput {
@@ -121,6 +128,12 @@ void validate_input(const FitInput &input);
 
 struct FitResult {
   RegistrationResult registration;        // per viewpoint: measured, corrected or why not (empty when off)
+  // The shading normals (3 per vertex, unit): the mesh's where the photos do not determine them.
+  // Empty when refinement is off or did not run (no Phong fit): the mesh's normals throughout.
+  std::vector<float> shading_normals;
+  std::vector<float> normal_moved;        // per vertex: degrees from the mesh normal, -1 not determined
+  ShadingNormalCounts shading_normal_counts;
+  std::string shading_normal_note;        // the report's summary (per viewpoint: median and p95 degrees)
   std::string registered_project;         // the .mlp with the corrected cameras ("" when none was corrected)
   std::vector<DiffuseEstimate> diffuse;   // per vertex
   std::vector<VertexFit> fits;            // per vertex (empty when fit_reflectance is off)
@@ -156,7 +169,8 @@ struct FitResult {
   std::string output_note;                // "new file" / "replaces the existing file (N bytes)"
   std::string memory_note;                // a photo larger than the photo memory: how it was handled
   size_t vertices_unseen = 0, vertices_no_diffuse = 0, vertices_coloured = 0, vertices_from_mixed = 0;
-  double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0, seconds_registration = 0;
+  double seconds_visibility = 0, seconds_gather = 0, seconds_output = 0, seconds_registration = 0,
+         seconds_normals = 0;  // shading normals: solve and re-shading (their refit counts in seconds_fit)
   // The stages around those (the report's second time line): colour chart search and correction
   // plan (in a thread of its own during the visibility passes, so not on the wall clock's path
   // unless it outlasts them), photo content checks, the diffuse-form pilot, the material stage, the neighbour fill and the albedo deconvolution.

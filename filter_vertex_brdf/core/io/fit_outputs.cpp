@@ -108,6 +108,8 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       rec.lobe_form = float(uint8_t(settings.phong.lobe));
       rec.diffuse_form = float(uint8_t(r.diffuse_forms.at(v)));
       rec.diffuse_deconvolved = v < r.albedo_deconvolved.size() ? float(r.albedo_deconvolved[v]) : 0.0f;
+      for (int k = 0; k < 3; ++k) rec.mesh_normal[k] = input.mesh.normals[3 * v + size_t(k)];
+      rec.normal_moved = v < r.normal_moved.size() ? r.normal_moved[v] : -1.0f;
       r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
@@ -130,6 +132,12 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
 }
 
 namespace {
+std::string shading_normal_report(const FitSettings &settings, const FitResult &r) {
+  if (!settings.fit_reflectance) return "";
+  if (!settings.shading_normals.enabled) return "shading normals: the mesh's (refinement off)\n";
+  return "shading normals: " + r.shading_normal_note + "\n";
+}
+
 // One line per viewpoint: measured misregistration before and after, or why it was not measured.
 std::string registration_report(const FitSettings &settings, const FitResult &r) {
   if (!settings.registration.enabled) return "registration: off (cameras as given)\n";
@@ -156,6 +164,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << (r.memory_note.empty() ? std::string() : r.memory_note + "\n")
       << "photos: " << input.rasters.size() << ", lights: " << r.light_file << " (" << r.light_model << ")\n"
       << registration_report(settings, r)
+      << shading_normal_report(settings, r)
       << "lights against the photos (predicted irradiance vs brightness): "
       << (r.light_agreement.empty() ? std::string("too few samples to tell") : r.light_agreement) << "\n"
       << "visibility back end: " << r.visibility_backend << "\n"
@@ -232,8 +241,9 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
         << fixed(per_iteration * double(cap_work - std::min<uint64_t>(cap_work, r.fit_iterations)), 2) << " s";
   }
   rep << "\n";
-  rep << "time: visibility " << fixed(r.seconds_visibility) << " s, samples " << fixed(r.seconds_gather - r.seconds_fit)
-      << " s, fit " << fixed(r.seconds_fit) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
+  rep << "time: visibility " << fixed(r.seconds_visibility) << " s, samples "
+      << fixed(r.seconds_gather - r.seconds_fit - r.seconds_normals) << " s, fit " << fixed(r.seconds_fit)
+      << " s, shading normals " << fixed(r.seconds_normals) << " s (" << g.chunks << " chunk(s), " << g.photo_loads << " photo decodes, "
       << g.host_photo_reads << " photos read from MeshLab's images, "
       << g.rasters_skipped << " raster x chunk pairs skipped)\n";
   rep << "time, other stages: registration " << fixed(r.seconds_registration) << " s, colour chart search and correction " << fixed(r.seconds_colors)

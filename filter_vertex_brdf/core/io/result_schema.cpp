@@ -73,6 +73,18 @@ std::vector<ResultAttribute> make_schema() {
        "it (absent: 0)",
        [](const R &r) { return r.diffuse_deconvolved; },
        [](R &r, float v) { r.diffuse_deconvolved = whole(v, 1.0f); }},
+      {"mesh_nx", K::Real, G::PhongFit, false,
+       "the mesh's own normal, x (nx ny nz are the shading normals the model was fitted with: refined from the "
+       "photos where they determine it, else these)",
+       [](const R &r) { return r.mesh_normal[0]; }, [](R &r, float v) { r.mesh_normal[0] = v; }},
+      {"mesh_ny", K::Real, G::PhongFit, false, "the mesh's own normal, y", [](const R &r) { return r.mesh_normal[1]; },
+       [](R &r, float v) { r.mesh_normal[1] = v; }},
+      {"mesh_nz", K::Real, G::PhongFit, false, "the mesh's own normal, z", [](const R &r) { return r.mesh_normal[2]; },
+       [](R &r, float v) { r.mesh_normal[2] = v; }},
+      {"normal_moved", K::Real, G::PhongFit, false,
+       "degrees between the shading normal and the mesh's normal; -1: the photos do not determine it (the mesh's "
+       "normal kept, or refinement off) (absent: -1)",
+       [](const R &r) { return r.normal_moved; }, [](R &r, float v) { r.normal_moved = v; }},
   };
 }
 } // namespace

@@ -25,6 +25,8 @@ struct VertexRecord {
   float lobe_form = 0.0f;  // LobeForm of the fit (samples/lobe.h): 0 R.E, 1 N.H; one value per result
   float diffuse_form = 0.0f;  // DiffuseForm at the vertex (samples/diffuse_form.h): 0 Lambert, 1 coated
   float diffuse_deconvolved = 0.0f;  // 1: k_d C deconvolved through the pixel footprints (albedo_deconvolution.h)
+  float mesh_normal[3] = {0.0f, 0.0f, 0.0f};  // the mesh's normal (the geometry's nx ny nz are the shading normal)
+  float normal_moved = -1.0f;  // degrees from the mesh normal to the shading normal; -1 not determined (shading_normals.h)
   VertexFit fit = {{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0, kFitNone, 0};  // sentinels
 };
 

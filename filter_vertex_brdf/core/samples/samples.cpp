@@ -1,4 +1,5 @@
 #include "samples/samples.h"
+#include "samples/reshade.h"
 
 #include <algorithm>
 #include <chrono>
@@ -217,14 +218,9 @@ uint16_t make_sample(const float position[3], const float normal_in[3], const Ra
 
   float light_dir[3];
   light_direction_at(light, position, light_dir);
-  const float d = dot3(n, light_dir);
-  const float s = lobe_cosine(LobeForm::PhongRE, n, light_dir, e);  // R.E: decides kHighlight
-  out.d = diffuse_factor(settings.diffuse.uniform, d, dot3(n, e));
-  out.lobe_cos = settings.lobe == LobeForm::PhongRE ? s : lobe_cosine(settings.lobe, n, light_dir, e);
-  if (d <= 0) flags |= kAttachedShadow;
+  shade_sample(n, light_dir, e, settings.diffuse.uniform, settings, out);  // d, lobe_cos, shading flags
+  flags |= out.flags;
   if (!light_clear) flags |= kCastShadow;
-  if (d > 0 && d < settings.diffuse_threshold) flags |= kGrazing;
-  if (d > 0 && s > settings.specular_threshold) flags |= kHighlight;
 
   if (!(flags & kNotSeen)) {
     own_texels &= kAllFootprintTexels;
