@@ -6,7 +6,6 @@
 // it takes to move the normals by DEG degrees median (a fine mesh needs more rounds than a coarse
 // one for the same smoothing). Prints how far the normals moved (median and p95 degrees).
 // The input is only read; the output may not be the input.
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +15,7 @@
 #include "base/errors.h"
 #include "base/mesh_adjacency.h"
 #include "base/vec3.h"
+#include "fit/shading_normals.h"  // summarise_moved
 #include "io/output_ply.h"
 #include "tools/mesh_io.h"
 
@@ -36,12 +36,6 @@ void smooth_normals(const MeshAdjacency &adj, int rounds, std::vector<float> &no
   }
 }
 
-float percentile(std::vector<float> values, double q) {
-  if (values.empty()) return 0;
-  const size_t k = std::min(values.size() - 1, size_t(q * double(values.size() - 1) + 0.5));
-  std::nth_element(values.begin(), values.begin() + long(k), values.end());
-  return values[k];
-}
 } // namespace
 
 int main(int argc, char **argv) {
@@ -79,7 +73,7 @@ int main(int argc, char **argv) {
     };
     smooth_normals(adjacency, rounds, mesh.normals);
     std::vector<float> angles = moved();
-    while (target_median > 0 && percentile(angles, 0.5) < target_median && rounds < 100) {
+    while (target_median > 0 && summarise_moved(angles).median < target_median && rounds < 100) {
       smooth_normals(adjacency, 1, mesh.normals);
       ++rounds;
       angles = moved();
@@ -87,8 +81,9 @@ int main(int argc, char **argv) {
     std::vector<uint8_t> colors = mesh.colors;
     if (colors.size() != 4 * (mesh.positions.size() / 3)) colors.assign(4 * (mesh.positions.size() / 3), 255);
     write_result_ply(out, mesh.view(), colors, {});
-    std::printf("normals moved: median %.2f deg, p95 %.2f deg (%d rounds of 1-ring averaging)\n", percentile(angles, 0.5),
-                percentile(angles, 0.95), rounds);
+    const MovedSummary moved_by = summarise_moved(angles);
+    std::printf("normals moved: median %.2f deg, p95 %.2f deg (%d rounds of 1-ring averaging)\n", moved_by.median,
+                moved_by.p95, rounds);
   } catch (const std::exception &e) {
     std::fprintf(stderr, "vbrdf_perturb_mesh: %s\n", e.what());
     return 1;

@@ -46,9 +46,9 @@ TangentFrame tangent_frame(const float n[3]) {
 }
 
 // The vertex's usable samples for the normal: lit by the mesh's shadow test (attached shadow is a
-// normal question and stays in), unsaturated, clean pixel, finite.
-// A vertex without a specular term leaves its highlight samples out: a lobe the model lacks must
-// not tilt the normal towards it.
+// normal question and stays in), unsaturated, clean pixel, finite; highlight samples only when
+// `specular` (use_highlights and a vertex with a lobe): a lobe the model lacks, or fitted with the
+// wrong normal, must not tilt the normal towards it.
 std::vector<NormalSample> normal_samples(const Sample *s, size_t count, const float p[3], const float *centres,
                                          const std::vector<LightSource> &lights, bool specular) {
   std::vector<NormalSample> out;

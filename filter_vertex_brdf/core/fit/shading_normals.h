@@ -8,11 +8,16 @@
 // Per vertex (the chunk's vertices with a model fitted from their own samples, fit_status 1 or 2):
 //   minimise  sum_i w_i rho(|P_i - f(n; L_i, E_i)| / sigma) + |x|^2 / sigma_m^2
 //   over n = normalise(n_mesh + x_1 t_1 + x_2 t_2) (t_1, t_2: the mesh normal's tangent plane),
-//   f the vertex's fitted model (phong_fit.h, reflectance held), w_i the sample's resolution weight,
-//   rho Huber at 2 sigma (a highlight the lobe misses does not drag the normal), sigma the samples'
-//   residual per channel at the current normal, floored at noise_floor x their mean brightness,
-//   sigma_m = mesh_normal_degrees (the prior: the mesh normal is right to within a few degrees).
-//   Gauss-Newton with Levenberg-Marquardt damping on numeric derivatives (double precision).
+//   f the vertex's model (phong_fit.h) with its fitted shininess held and k_d C and k_s solved in
+//   closed form at each trial normal (variable projection: brightness and tilt trade against each
+//   other, so solving them together converges where alternating crawls), w_i the sample's
+//   resolution weight, rho Huber at 2 sigma, sigma the samples' residual per channel at the
+//   current normal, floored at noise_floor x their mean brightness, sigma_m = mesh_normal_degrees
+//   (the prior: the mesh normal is right to within a few degrees). Highlight samples are left out
+//   unless use_highlights (and the vertex has a lobe): a lobe fitted with the wrong normal would
+//   otherwise pull the normal towards it. Gauss-Newton with Levenberg-Marquardt damping on numeric
+//   derivatives (double precision). The mesh normal is kept unless the solution lowers the cost by
+//   more than min_gain (noise alone does not move a right normal).
 // Then over the mesh: the corrections x (as tangent vectors) are smoothed towards the neighbours'
 //   with strength 1 / neighbour_degrees^2 against each vertex's own information matrix (Jacobi
 //   sweeps within the chunk), so a vertex the samples determine weakly in one direction (lights all
@@ -44,7 +49,7 @@ struct ShadingNormalSettings {
   float noise_floor = 0.01f;         // residual spread never below this fraction of the mean brightness
   int iterations = 8;                // Gauss-Newton steps per vertex
   int neighbour_sweeps = 8;          // Jacobi sweeps of the neighbour smoothing
-  float min_gain = 4.6f;              // cost fall that moves a normal (half the 99 % chi-square of 2 dof)
+  float min_gain = 4.6f;             // cost fall that moves a normal (half the 99 % chi-square of 2 dof)
   bool use_highlights = false;       // highlight samples inform the normal too (where the vertex has a lobe)
   int rounds = 3;                    // alternations: refine the normals, shade again, fit again
   float converged_degrees = 0.05f;   // a normal that moves less in a round is converged: kept, not refitted
@@ -68,8 +73,8 @@ ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshV
                                            const ShadingNormalSettings &settings, const uint8_t *active, float *normals,
                                            float *moved_degrees, uint8_t *changed);
 
-// Median and 95th percentile of the values >= 0 of `moved_degrees` over `vertices` (all when empty);
-// count = how many there were.
+// Median and 95th percentile of the values >= 0 of `moved_degrees` at the vertices with select[v]
+// != 0 (all when `select` is empty); count = how many there were.
 struct MovedSummary {
   size_t count = 0;
   float median = 0, p95 = 0;
