@@ -11,7 +11,8 @@ OUT="$(cd "$3" && pwd)"
 NAME="$(basename "$SAMPLE")"
 RESULT="$OUT/${NAME}_brdf.ply"
 rm -f "$RESULT" "$OUT/${NAME}_brdf_report.txt"
-# The parameter's type is kept as the sample wrote it (paths are RichString fields, see the README).
+# The parameter's type is kept as the sample wrote it (paths are RichString fields, see
+# docs/parameters.md#how-the-dialogs-behave).
 sed "s|name=\"outputPly\" type=\"\([A-Za-z]*\)\" value=\"[^\"]*\"|name=\"outputPly\" type=\"\1\" value=\"$RESULT\"|" \
   "$SAMPLE/fit.mlx" > "$OUT/fit.mlx"
 grep -q "value=\"$RESULT\"" "$OUT/fit.mlx" \

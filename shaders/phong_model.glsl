@@ -17,7 +17,8 @@
 // Vertices with k_s = 0 carry the median shininess of the fitted lobes (chosen on the CPU), so
 // that a lobe fades with k_s across a triangle instead of widening.
 //
-// Differences between the two users (stated here and in the README, "Live relighting"):
+// Differences between the two users (stated here and in
+// docs/live_relighting.md#differences-between-the-two-renderers):
 //   - cast shadows: the relight renderer tests a shadow map; the live view has none (attached
 //     shadows only), so where the object shadows itself the live view is lit;
 //   - E: the relight renderer's camera is always perspective; the live view takes MeshLab's,

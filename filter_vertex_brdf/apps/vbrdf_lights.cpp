@@ -1,6 +1,6 @@
 // vbrdf-lights: light directions from photos of one or two mirror spheres, as an RTI .lp, without
 // a MeshLab project (the installed counterpart of the filter "Vertex BRDF: estimate light
-// directions from a reflective sphere"). Run with --help for the usage; README, "vbrdf-lights".
+// directions from a reflective sphere"). Run with --help for the usage; docs/parameters.md#vbrdf-lights-command-line.
 //
 // The work is the core's (calibration/sphere_lights.h): detection or a given circle, checked
 // against the photos (check_sphere_circle), highlights and their mirror reflection, photos whose

@@ -52,7 +52,8 @@ std::vector<vbrdf::VertexAttribute> coverage_attributes(const vbrdf::CoverageRes
 QString CoverageFilter::name() const { return "Vertex BRDF: coverage and next light"; }
 
 QString CoverageFilter::info() const {
-  // Short on purpose (see FitFilter::info); the details are in the README and the tooltips.
+  // Short on purpose (see FitFilter::info); the details are in
+  // docs/parameters.md#vertex-brdf-coverage-and-next-light and the tooltips.
   return "Acquisition feedback: which vertices the photos so far cover (<b>purple</b> unseen, <b>blue</b> no "
          "diffuse sample, <b>yellow</b> no specular sample, <b>green</b> covered) and where to put the light next "
          "(log and a text file). Vertices only a new viewpoint can cover are selected.";

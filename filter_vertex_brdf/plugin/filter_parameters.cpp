@@ -108,7 +108,8 @@ void add_light_placement(RichParameterList &params) {
                             "0: the .lp's directions are distant lights (one direction for the whole object). "
                             "> 0: they are point lights on a dome of this radius around the mesh's centre, so "
                             "that each vertex gets its own light direction and a 1/distance^2 fall-off. Use it "
-                            "when the lights are within about 10 object sizes (README, \"Near lights\")."));
+                            "when the lights are within about 10 object sizes "
+                            "(docs/parameters.md#near-lights-light-positions)."));
   params.addParam(RichFloat(kLightUnitScale, 0.0f, "Light unit scale",
                             "Mesh units per unit of the light file's positions: 0 = the .json's positions are in "
                             "mesh units; a Relight .dome is in cm and needs it (10 for a mesh in mm, 0.01 for "

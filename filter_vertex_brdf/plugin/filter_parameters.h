@@ -8,7 +8,7 @@
 // Names are what .mlx scripts refer to: never rename one. Readers throw vbrdf::InputError
 // ("Parameter '<name>' ...") for a value out of range; they never return NaN.
 //
-// Where the filters used to disagree, the one rule is (README, "Filter parameters"):
+// Where the filters could differ, one rule holds in all of them (docs/architecture.md#filter-parameters-one-owner-each):
 // - minSpecularSamples: 2 (the fit's) in coverage too, so that "fully covered" means what the fit
 //   needs for a Phong fit rather than a diffuse-only one.
 // - shadowMapSize: 0 = automatic (from the mesh's edge lengths) in every filter, coverage included.
@@ -50,7 +50,7 @@ std::vector<float> parse_corners(const QString &text, const char *param);
 // The tooltip says so ("type or paste the path").
 void add_path(RichParameterList &params, const char *name, const QString &label, const QString &tooltip);
 // The path as given ("" when empty; not resolved). Reads the string the dialog produces and also
-// the file value (RichOpenFile/RichSaveFile) of an .mlx script written before the change.
+// a file value (RichOpenFile/RichSaveFile), which an .mlx script may hold.
 std::string path(const RichParameterList &params, const char *name);
 
 // `message` with every quoted parameter name ('lightFile') replaced by its dialog label and the

@@ -46,7 +46,7 @@ QString FitFilter::name() const { return "Vertex BRDF: fit per-vertex reflectanc
 
 QString FitFilter::info() const {
   // Short on purpose: MeshLab 2020.09 puts this text above the fields, and a long one pushes Apply
-  // off a 1000-pixel screen. The details are in the README and in each field's tooltip / Help.
+  // off a 1000-pixel screen. The details are in docs/parameters.md and in each field's tooltip / Help.
   return "Fits Phong reflectance (colour, k<sub>d</sub>, k<sub>s</sub>, shininess) to every vertex from the visible "
          "registered photos and their lights; colours the mesh with the albedo and writes a PLY with every "
          "per-vertex value and a report. Hover over a field, or press Help, for what it does.";

@@ -1,6 +1,6 @@
 #pragma once
-// MeshLab's decoded raster images handed to the core's photo cache (issue 13: decode each photo
-// once). MeshLab 2020.09 decodes every raster's photo into a QImage when it opens a project
+// MeshLab's decoded raster images handed to the core's photo cache, so that each photo is decoded
+// once. MeshLab 2020.09 decodes every raster's photo into a QImage when it opens a project
 // (Plane::Plane: QImage(path)); the fit reads those pixels in place instead of decoding the file a
 // second time and holding it twice in memory.
 #include <memory>

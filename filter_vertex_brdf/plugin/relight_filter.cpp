@@ -198,7 +198,8 @@ void render_novel_view(vbrdf::RelightRenderer &renderer, const RasterSet &set, c
 QString RelightFilter::name() const { return "Vertex BRDF: relight and compare"; }
 
 QString RelightFilter::info() const {
-  // Short on purpose (see FitFilter::info); the details are in the README and the tooltips.
+  // Short on purpose (see FitFilter::info); the details are in
+  // docs/parameters.md#vertex-brdf-relight-and-compare and the tooltips.
   return "Renders the fitted per-vertex Phong model (the attributes the fit stored, or its PLY) with OpenGL for "
          "every raster's camera and light, or a novel view, and compares it with the photos: images, a contact "
          "sheet and a table of CIEDE2000 and PSNR in the output folder. The mesh is not changed. Hover over a "

@@ -12,6 +12,9 @@
 #include <vcg/complex/algorithms/local_optimization/tri_edge_collapse_quadric.h>
 #include <vcg/complex/algorithms/update/normal.h>
 #include <vcg/complex/algorithms/update/topology.h>
+#include <vcg/complex/algorithms/closest.h>
+#include <vcg/complex/algorithms/update/bounding.h>
+#include <vcg/space/index/grid_static_ptr.h>
 
 namespace vbrdf {
 namespace bench {
@@ -51,6 +54,16 @@ void to_vcg(const MeshData &in, DMesh &m) {
   for (size_t f = 0; f < nf; ++f, ++fi)
     for (int k = 0; k < 3; ++k) fi->V(k) = &m.vert[in.indices[3 * f + size_t(k)]];
 }
+
+// The surface a point is projected onto: faces with the normals and marks vcglib's closest-point
+// query wants.
+class SVertex;
+class SFace;
+struct STypes : public vcg::UsedTypes<vcg::Use<SVertex>::AsVertexType, vcg::Use<SFace>::AsFaceType> {};
+class SVertex : public vcg::Vertex<STypes, vcg::vertex::Coord3f, vcg::vertex::Normal3f, vcg::vertex::BitFlags> {};
+class SFace : public vcg::Face<STypes, vcg::face::VertexRef, vcg::face::Normal3f, vcg::face::Mark,
+                               vcg::face::BitFlags> {};
+class SMesh : public vcg::tri::TriMesh<std::vector<SVertex>, std::vector<SFace>> {};
 
 MeshData from_vcg(DMesh &m) {
   vcg::tri::Allocator<DMesh>::CompactEveryVector(m);
@@ -142,6 +155,47 @@ std::vector<size_t> nearest_vertices(const MeshView &from, const MeshView &to) {
     out[size_t(v)] = best_index;
   }
   return out;
+}
+
+std::vector<float> resample_onto(const MeshData &surface, MeshData &mesh) {
+  const size_t ns = surface.positions.size() / 3, nf = surface.indices.size() / 3;
+  if (ns == 0 || nf == 0 || surface.normals.size() != 3 * ns)
+    throw std::runtime_error("resample_onto: the surface needs faces and vertex normals");
+  SMesh s;
+  auto vi = vcg::tri::Allocator<SMesh>::AddVertices(s, ns);
+  for (size_t v = 0; v < ns; ++v, ++vi) {
+    vi->P() = vcg::Point3f(&surface.positions[3 * v]);
+    vi->N() = vcg::Point3f(&surface.normals[3 * v]);
+  }
+  auto fi = vcg::tri::Allocator<SMesh>::AddFaces(s, nf);
+  for (size_t f = 0; f < nf; ++f, ++fi)
+    for (int k = 0; k < 3; ++k) fi->V(k) = &s.vert[surface.indices[3 * f + size_t(k)]];
+  // Zero-area faces (at a UV sphere's poles, say) have no barycentric coordinates to interpolate with.
+  vcg::tri::Clean<SMesh>::RemoveZeroAreaFace(s);
+  vcg::tri::Allocator<SMesh>::CompactFaceVector(s);
+  vcg::tri::UpdateNormal<SMesh>::PerFaceNormalized(s);
+  vcg::tri::UpdateBounding<SMesh>::Box(s);
+  vcg::GridStaticPtr<SFace, float> grid;
+  grid.Set(s.face.begin(), s.face.end());
+
+  const size_t nv = mesh.positions.size() / 3;
+  mesh.normals.resize(3 * nv);
+  std::vector<float> moved(nv, 0.0f);
+  const float max_distance = s.bbox.Diag();
+  // Serial: the query marks faces in the mesh it searches.
+  for (size_t v = 0; v < nv; ++v) {
+    const vcg::Point3f p(&mesh.positions[3 * v]);
+    float distance = max_distance;
+    vcg::Point3f closest, normal, barycentric;
+    if (!vcg::tri::GetClosestFaceBase(s, grid, p, max_distance, distance, closest, normal, barycentric)) continue;
+    normal.Normalize();
+    for (int k = 0; k < 3; ++k) {
+      mesh.positions[3 * v + size_t(k)] = closest[k];
+      mesh.normals[3 * v + size_t(k)] = normal[k];
+    }
+    moved[v] = (closest - p).Norm();
+  }
+  return moved;
 }
 
 } // namespace bench

@@ -1,7 +1,7 @@
 #pragma once
 // Mesh helpers of the benchmark: quadric-edge-collapse decimation (vcglib, as MeshLab's
 // "Simplification: Quadric Edge Collapse Decimation") and nearest-vertex transfer of per-vertex
-// ground truth onto a decimated mesh.
+// ground truth onto a decimated mesh; a mesh resampled onto a decimated copy of itself.
 #include <cstddef>
 #include <vector>
 
@@ -17,6 +17,12 @@ MeshData decimate(const MeshData &in, size_t target_vertices);
 
 // For every vertex of `to`, the index of the nearest vertex of `from` (uniform grid, exact).
 std::vector<size_t> nearest_vertices(const MeshView &from, const MeshView &to);
+
+// Moves every vertex of `mesh` to the closest point of `surface` (vcglib's uniform grid) and gives
+// it `surface`'s vertex normals interpolated there (barycentric): `mesh`'s own vertices and faces
+// with the geometry of `surface`, e.g. of its decimated copy. `surface` needs faces and vertex
+// normals (throws otherwise). Returns how far each vertex moved.
+std::vector<float> resample_onto(const MeshData &surface, MeshData &mesh);
 
 } // namespace bench
 } // namespace vbrdf

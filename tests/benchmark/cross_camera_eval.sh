@@ -1,5 +1,5 @@
 #!/bin/sh
-# Fitted on one camera, scored on another (issue 16): the spot pair of <shared>/scenes
+# Fitted on one camera, scored on another: the spot pair of <shared>/scenes
 # (spot_dir24 and spot_dir24_view2: one mesh and vertex order, two cameras 45 degrees apart, each
 # with its own training and held-out photos). Each camera's project is fitted alone (16-bit linear
 # photos, colour correction off, the .lp's directions); every fit is then scored at each camera's
@@ -7,7 +7,8 @@
 # RTI cannot use another camera's photos at all). "both": one project holding every camera's
 # training photos (tests/tools/merge_projects.py), fitted once and scored at each camera,
 #   (a) over the ground-truth-visible vertices of the scored camera ("all"), and
-#   (b) over those that every fit models ("common": fit_status != 0 in each), the issue's protocol.
+#   (b) over those that every fit models ("common": fit_status != 0 in each), so that every fit is
+#       scored on the same vertices.
 #   tests/benchmark/cross_camera_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_fit OPTIONS...]
 #   environment: VBRDF_SHARED_DIR (default <repo>/../shared), CAMERAS (default "spot_dir24 spot_dir24_view2"),
 #   SETS (default "all common": the vertex sets scored), VBRDF_EVAL_OPTIONS (extra vbrdf_eval options,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""What a photo's pixel footprint does to a shared scene's pixels (issue 16, README "Ninth step").
+"""What a photo's pixel footprint does to a shared scene's pixels (docs/decisions/pixel_footprint_lobe.md).
 
     footprint_oracle.py SCENE_DIR [--photos heldout|training] [--common OTHER_SCENE_DIR] [--pooled-lobe]
 
@@ -19,7 +19,7 @@ within 5 %). --common: only vertices that camera sees too (the spot pair). --poo
 glossy vertices' training samples near the highlight (N.H within 0.3 rad), the photo minus the true
 diffuse against one GGX lobe k * spec(alpha) with k free, at the vertex and through the footprint,
 over a grid of alpha: the roughness each explains the photos with best.
-Only numpy and the repository's scripts. Figures: README, "Ninth step".
+Only numpy and the repository's scripts. Figures: docs/decisions/pixel_footprint_lobe.md.
 """
 import argparse
 import json

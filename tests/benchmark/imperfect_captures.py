@@ -2,7 +2,8 @@
 """Relighting with the inputs a real capture gives: each shared scene fitted from a copy of its
 project whose cameras are off (perturb_cameras.py: principal point shifted by 1 and 2 px, camera
 turned 0.2 deg) or whose mesh normals are smoothed as a scan's are (vbrdf_perturb_mesh: 1-ring
-averaging until they are 3.5 deg off in median), with the step that corrects it (registration
+averaging until they are 3.5 deg off in median) or decimated to half its vertices (vbrdf_perturb_mesh
+--decimate 0.5: every vertex moved onto the decimated surface, its normal interpolated there), with the step that corrects it (registration
 refinement, shading normals from the photos) off and on, and scored on the held-out photos with the
 exact cameras over the whole visible surface (vbrdf_eval, the RTI protocol), beside per-pixel PTM and
 RBF fitted on the same training photos (per pixel: no camera and no mesh, so neither error).
@@ -34,6 +35,7 @@ CAPTURES = [  # name, perturb_cameras.py arguments, vbrdf_perturb_mesh arguments
     ("yaw 0.2 deg", ["--rotate", "y", "0.2"], [], "registration"),
     ("roll 0.2 deg", ["--rotate", "z", "0.2"], [], "registration"),
     ("normals smoothed", [], ["--smooth-normals", "3", "--target-median", "3.5"], "shading-normals"),
+    ("decimated half", [], ["--decimate", "0.5"], "shading-normals"),
 ]
 STEP_DEFAULTS = {"registration": "off", "shading-normals": "on"}  # the other step, as the product runs
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Specular figures of a fit against a shared scene's ground truth (issue 16).
+"""Specular figures of a fit against a shared scene's ground truth.
 
   material_stats.py FIT.ply SCENE_DIR [--check]
   material_stats.py --fit-tool vbrdf_fit --work DIR SCENE_DIR [--check]
@@ -10,7 +10,8 @@ shininess of glossy vertices with k_s > 0 against the truth for the fit's lobe f
 `phong_shininess_approx` is the N.H exponent; the R.E exponent is about a quarter of it); and the found `material` labels against
 the true `material_id` (vertex counts per pair). Needs numpy.
 --fit-tool: fit SCENE_DIR/project.mlp first (16-bit linear photos, colour correction off, the fit's
-defaults: the issue's protocol) into DIR/fit.ply. --check: exit 1 unless issue 16's bounds hold: >= 95 %
+defaults: the acceptance protocol) into DIR/fit.ply. --check: exit 1 unless the lobe acceptance
+bounds hold: >= 95 %
 of the glossy vertices with k_s > 0, >= 95 % of the diffuse ones with k_s below 1 % of k_d, and the
 median exponent within 30 % of the truth for the lobe's form.
 """
@@ -62,7 +63,7 @@ def main():
         if np.mean(ks[d] <= 0.01 * kd[d]) < 0.95:
             failures.append('diffuse vertices with k_s ~ 0 below 95 %')
     sel = g & (ks > 0)
-    # The lobe's form from the fit's per-vertex lobe_form (absent: R.E, files before issue 16).
+    # The lobe's form from the fit's per-vertex lobe_form (absent from a file: R.E).
     nh = 'lobe_form' in fit.dtype.names and bool(np.any(fit['lobe_form'][vis] > 0.5))
     if sel.any():
         truth = float(np.median(gt['phong_shininess_approx'][g]))
@@ -90,7 +91,7 @@ def main():
             print('FAIL: ' + f)
         if failures:
             return 1
-        print('OK: issue 16 bounds on the lobes hold')
+        print('OK: the acceptance bounds on the lobes hold')
     return 0
 
 

@@ -22,7 +22,7 @@ the same mesh), by that camera's N.E. The diffuse base uses the material's own t
 against incidence from gt_scene.json (the rough coat's transmission, in and out), else a quadrature.
 Self-check: the script's CIEDE2000 of the product's predictions must match vbrdf_eval's (exit 1
 otherwise). Needs numpy; only for roughplastic materials under directional lights (the shared
-scenes with directional lights). Figures: README, "What the true reflectance scores".
+scenes with directional lights). Figures: docs/decisions/true_reflectance.md.
 """
 import csv
 import json

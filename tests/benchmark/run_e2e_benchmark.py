@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""End-to-end benchmark through meshlabserver (issue 13): wall time, peak memory, stage times and
+"""End-to-end benchmark through meshlabserver: wall time, peak memory, stage times and
 errors of the fit filter at its defaults, on synthetic captures made by synthesize_scene.
 
   run_e2e_benchmark.py --wrapper <build>/meshlab_run/run_meshlabserver.sh

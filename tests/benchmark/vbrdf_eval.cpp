@@ -104,7 +104,9 @@ std::vector<uint8_t> load_visible(const std::string &path, const MeshData &mesh)
     extent = std::max(extent, std::fabs(mesh.positions[k]));
     worst = std::max(worst, std::fabs(mesh.positions[k] - gt.mesh.positions[k]));
   }
-  if (!(worst <= 1e-4f * std::max(extent, 1e-6f)))
+  // Another vertex order moves vertices by about the object's size; a scan's copy of the mesh
+  // (decimated and resampled, vbrdf_perturb_mesh) by a small fraction of it.
+  if (!(worst <= 0.02f * std::max(extent, 1e-6f)))
     throw InputError(path + ": vertex positions differ from the result's (another vertex order?)");
   std::vector<uint8_t> visible(n);
   for (size_t v = 0; v < n; ++v) visible[v] = it->second[v] != 0;

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Whole-surface relighting evaluation against per-pixel RTI baselines (issue 9, item 4).
+# Whole-surface relighting evaluation against per-pixel RTI baselines.
 # For each scene of <shared>/scenes: fit the training project (16-bit linear photos, colour
 # correction off) with vbrdf_fit, then score the result on the held-out photos with vbrdf_eval
 # over the ground-truth-visible vertices, beside PTM and Relight-style RBF fitted per pixel on the
@@ -7,7 +7,7 @@
 #   tests/benchmark/whole_surface_eval.sh [BUILD_DIR] [WORK_DIR] [EXTRA vbrdf_eval OPTIONS...]
 #     BUILD_DIR  default build/release (holding tests/benchmark/vbrdf_fit and vbrdf_eval)
 #     WORK_DIR   default $BUILD_DIR/whole_surface_eval (fit results and logs)
-#   environment: VBRDF_SHARED_DIR (default <repo>/../shared; VBRDF_SHARED is still read), SCENES (default the three below),
+#   environment: VBRDF_SHARED_DIR (default <repo>/../shared; VBRDF_SHARED is also read), SCENES (default the three below),
 #                VBRDF_FIT_OPTIONS (extra vbrdf_fit options, e.g. "--visibility cpu"),
 #                LIGHT_POSITIONS (default on: a scene with lights_world.json, i.e. point lights, is fitted and
 #                scored with those positions; off: with the directions of its lights.lp, as an RTI user would)

@@ -1,4 +1,4 @@
-"""The bad-input corpus (issue 17): each case breaks, or makes odd, a copy of a sample project the
+"""The bad-input corpus: each case breaks, or makes odd, a copy of a sample project the
 way real captures do, and says what the run must give.
 
 A case is `Case(name, group, outcome, what, edit)`:
@@ -8,7 +8,7 @@ A case is `Case(name, group, outcome, what, edit)`:
           most vertices coloured), its log contains every string `edit` returns.
 Every case: the inputs are byte-for-byte unchanged. `edit(ctx)` changes the copy in ctx.proj_dir
 (and ctx.values: filter parameters; ctx.env: environment) and returns the expected strings.
-`what` is the README's one-line description of what the case gets.
+`what` is the one-line description in docs/testing.md#the-corpus of what the case gets.
 """
 import json
 import os

@@ -77,7 +77,7 @@ def check(out_path, input_mesh_path, gt_path, fit="scalar", max_rel=None, max_de
     if np.any(est[coloured] < 0):
         failures.append("negative diffuse reflectance")
     if "fit_status" in v.dtype.names:
-        # Issue 9: every vertex a photo sees has a model, and one consistent output: the written
+        # Every vertex a photo sees has a model, and one consistent output: the written
         # diffuse reflectance is the model's k_d C.
         modelled = v["fit_status"] > 0.5
         if np.any(~unseen & ~modelled):

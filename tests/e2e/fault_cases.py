@@ -1,4 +1,4 @@
-"""Faults while writing (issue 17): nothing is lost when a run is killed while it writes, the disk
+"""Faults while writing: nothing is lost when a run is killed while it writes, the disk
 fills, the output folder is read-only or two runs write the same output at once.
 
 Every case starts from a previous result in the output folder (result.ply and its report) and

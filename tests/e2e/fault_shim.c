@@ -1,4 +1,4 @@
-/* LD_PRELOAD shim for the fault cases of run_e2e.py (issue 17): makes a run die or dawdle at a
+/* LD_PRELOAD shim for the fault cases of run_e2e.py: makes a run die or dawdle at a
  * chosen point of writing an output, without any hook in the product.
  *   VBRDF_FAULT=kill_mid_write  SIGKILL once 64 KiB went through fwrite into a temporary
  *                               (name containing ".tmp") of a file whose name contains VBRDF_FAULT_TARGET

@@ -1,4 +1,4 @@
-// The acceptance check of the live view in MeshLab (issue 14): a screenshot of MeshLab's 3-D view
+// The acceptance check of the live view in MeshLab: a screenshot of MeshLab's 3-D view
 // drawn by the render plugin "Vertex BRDF: relight" against the relight renderer's image of the
 // same view and light (OSMesa), from the fit's result PLY and the view the plugin logged
 // (live_view_file.h).

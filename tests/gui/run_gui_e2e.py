@@ -11,7 +11,7 @@ gets a typed light file (in a folder the default search never looks in, with a s
 and a typed output PLY. Passes only if the fit read the one and wrote the other, and wrote nothing
 at the default output path. dialogs: every Vertex BRDF dialog opens from its menu; their sizes
 are printed and screenshots kept in W/<filter>/.
-live-relight (issue 14): on a copy of the project the fit is applied, the render mode "Vertex BRDF:
+live-relight: on a copy of the project the fit is applied, the render mode "Vertex BRDF:
 relight" switched on and the light moved (Ctrl+Shift+drag); both screenshots of the 3-D view must
 match the relight renderer's image of the logged view and light (C = vbrdf_live_view_check), and
 the light must have moved. live-relight-no-model: the render mode on the mesh without a fit must

@@ -4,7 +4,8 @@ reference directions in light_directions.txt as 3 rows of n, the set's circle in
 circle_data.txt with y counted from the bottom edge, MATLAB style). Checks:
 
 1. the set's circle with --origin bottom-left: the .lp is written, every photo has a light, median
-   and largest error against the reference within the README's figures (median < 1 deg, max < 3);
+   and largest error against the reference within the figures of
+   docs/acquisition.md#calibration-accuracy (median < 1 deg, max < 3);
 2. the same numbers with --origin top-left (the mistake that gave 41-56 deg errors): the tool fails
    loudly (exit status 1, "not a sphere"), writes nothing;
 3. --circle without --origin is refused (exit status 2);

@@ -1,4 +1,4 @@
-// EXIF orientation (issue 17): MeshLab 2020.09 loads a raster's photo with QImage(path)
+// EXIF orientation: MeshLab 2020.09 loads a raster's photo with QImage(path)
 // (src/common/meshmodel.cpp, Plane::Plane), and Qt 5's QImageReader does not apply the EXIF
 // orientation by default (autoTransform() is false), so MeshLab shows and registers the photo as
 // its pixels are stored. The fit must read the same pixels: OpenCV's IMREAD_UNCHANGED (load_photo)

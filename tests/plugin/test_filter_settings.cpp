@@ -175,9 +175,9 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
 TEST(CoverageSettingsFrom, DefaultsAgreeWithTheFit) {
   const vbrdf::CoverageSettings s = CoverageFilter::settings_from(defaults_of(CoverageFilter()));
   const vbrdf::FitSettings fit = FitFilter::settings_from(defaults_of(FitFilter()));
-  // "Fully covered" means what the fit needs for a Phong fit (it was 1 against the fit's 2).
+  // "Fully covered" means what the fit needs for a Phong fit (the fit's minimum, not a lower one).
   EXPECT_EQ(s.min_specular, fit.phong.min_specular_samples);
-  // 0 = automatic shadow map, as in the fit (coverage used to default to 2048 and reject 0).
+  // 0 = automatic shadow map, in coverage as in the fit (and 0 is accepted there).
   EXPECT_EQ(s.visibility.shadow_map_size, fit.visibility.shadow_map_size);
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, fit.gather.specular_threshold);
   EXPECT_FLOAT_EQ(s.gather.saturation_level, fit.gather.saturation_level);
@@ -468,10 +468,11 @@ TEST(SharedParameters, DefaultOutputLightFileSitsBesideTheProject) {
             "/data/scan/project_lights.lp");
 }
 
-// --- Typed paths (issue 12) --------------------------------------------------------------------
-// MeshLab 2020.09's file widgets return only a path picked with "...": a typed path was lost. Every
-// path parameter is a string field now; the dialog's line edit (LineEditWidget::collectWidgetValue)
-// hands the typed text over as a StringValue, which is what these tests feed in.
+// --- Typed paths -----------------------------------------------------------------------------------
+// MeshLab 2020.09's file widgets return only a path picked with "...", so a typed path would be
+// lost. Every path parameter is therefore a string field; the dialog's line edit
+// (LineEditWidget::collectWidgetValue) hands the typed text over as a StringValue, which is what
+// these tests feed in.
 
 TEST(TypedPaths, NoFilterDeclaresAFileFieldThatDropsTypedText) {
   size_t paths = 0;

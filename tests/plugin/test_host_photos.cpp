@@ -1,4 +1,4 @@
-// Photos read in place from MeshLab's decoded images (issue 13: decode each photo once). For every
+// Photos read in place from MeshLab's decoded images, so that each photo is decoded once. For every
 // layout Qt gives the photo formats the fit accepts (8-bit RGB/RGBA/grey PNG, JPEG, 16-bit RGB and
 // grey PNG), the wrapped QImage must decode to exactly what the fit's own decoder (OpenCV) makes of
 // the same file: the same samples, the same linear image, the same content fingerprint. And a

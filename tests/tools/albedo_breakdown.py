@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Where the albedo error of a fit comes from (issue 9's "albedo over all visible vertices").
+"""Where the albedo error of a fit comes from (the acceptance figure "albedo over all visible
+vertices").
 
     tests/tools/albedo_breakdown.py FIT.ply SCENE_DIR [--ior X] [--max-mean M] [--max-p95 P]
     tests/tools/albedo_breakdown.py --fit-tool vbrdf_fit --work DIR SCENE_DIR [...]
@@ -21,9 +22,10 @@ Prints, besides the score:
     divided by the coating's Fresnel transmission at their exit angle, T(theta_o) / T(0) (N.E
     clipped at 0.15) with the ground-truth material (an oracle) and with coated vertices chosen
     from the fit's specular evidence (coated_from_fit).
---fit-tool / --work: fit SCENE_DIR/project.mlp first (its photos, colour correction Auto: issue 9's
-protocol, "colour correction Auto where a chart is in view"; the fit's other defaults) into
-DIR/fit.ply. --max-mean / --max-p95: bounds on the acceptance figure (issue 9: 2.5 and 8).
+--fit-tool / --work: fit SCENE_DIR/project.mlp first (its photos, colour correction Auto: the
+acceptance protocol, "colour correction Auto where a chart is in view"; the fit's other defaults)
+into DIR/fit.ply. --max-mean / --max-p95: bounds on the acceptance figure (the albedo acceptance
+bounds over all visible vertices: 2.5 and 8).
 Only the standard library and numpy. Exit status 0, 1 when a bound is exceeded or the fit fails,
 2 on bad arguments.
 """

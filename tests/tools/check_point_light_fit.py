@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""ctest driver (synth_point_light_fit, issue 11): the fit recovers k_d, k_s and alpha under near
+"""ctest driver (synth_point_light_fit): the fit recovers k_d, k_s and alpha under near
 point lights as well as under directional lights, when it is given the light positions.
 
     check_point_light_fit.py --synth synthesize_scene --fit-tool vbrdf_fit --workdir DIR

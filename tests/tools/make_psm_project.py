@@ -54,8 +54,8 @@ Method (python3 + numpy only):
   * Camera: identity rotation, centre (0, 0, D) with D = --camera-distance (default 1e5 px, far
     compared with any relief, so the view is nearly orthographic as lights.txt assumes),
     f = D px at depth 0 (FocalMm = D * PixelSizeMm), CenterPx = (W/2, H/2). Each vertex's x, y
-    is set from its pixel centre and depth so that MeshLab's projection (README "Conventions" of
-    the shared scenes: cp = R (p - C), cp.z = -cp.z, px = f cp.xy / cp.z / PixelSizeMm + CenterPx,
+    is set from its pixel centre and depth so that MeshLab's projection (the "Conventions" of the
+    shared scenes' own README: cp = R (p - C), cp.z = -cp.z, px = f cp.xy / cp.z / PixelSizeMm + CenterPx,
     VCG pixels with y up, origin bottom-left) lands exactly on it: pixel (col c, top-down row r)
     -> VCG (c + 0.5, H - r - 0.5). The tool re-projects every vertex (float32 as written, camera
     parsed back from the written .mlp) and fails when any lands more than 0.01 px off.

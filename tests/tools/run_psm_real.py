@@ -7,6 +7,7 @@ lights.
     run_psm_real.py --data DIR --workdir DIR --fit-tool vbrdf_fit --eval-tool vbrdf_eval
                     [--objects owl cat] [--photos linear|srgb] [--fit-options "--lobe re"]
                     [--decoding-check fail|warn] [--no-worse-than "--diffuse lambert" [--tolerance 0.02]]
+                    [--perturb-mesh "vbrdf_perturb_mesh --smooth-normals 3 --target-median 3.5"]
 
 Checks (each can fail):
   * the set's decoding (Seitz set only: the Harvard set has no grey sphere): on the matte grey sphere, grey ~ (N.L)^g with |g - 1| < 0.25 for the
@@ -22,6 +23,8 @@ Checks (each can fail):
     object's pixels (object_pixels.ply) the product is below per-pixel PTM and RBF in mean and p95;
   * with --no-worse-than OPTIONS: a second fit with those options added, and the defaults' mean and
     p95 within --tolerance of it (ctest psm_real_auto_choice: Auto's diffuse form against Lambert).
+With --perturb-mesh TOOL ARGS: the relief's mesh.ply is replaced by TOOL's copy of it (mesh_exact.ply
+keeps the builder's), e.g. normals smoothed as a scan's are; the checks are the same.
 Printed for the record: share of vertices per fit_status, relit CIEDE2000 mean / p95.
 Exit status 77 (ctest SKIP_RETURN_CODE) when the data folder is absent, 1 on a failed check.
 """
@@ -137,6 +140,14 @@ def check_object(args, name):
         return ['%s: builder: %s' % (name, e)]
     _, mask, _ = psm.load_object(args.data, name)
     failures += ['%s: %s' % (name, f) for f in check_registration(out, mask)]
+    if args.perturb_mesh:
+        mesh, exact = os.path.join(out, 'mesh.ply'), os.path.join(out, 'mesh_exact.ply')
+        os.replace(mesh, exact)
+        tool, *tool_args = args.perturb_mesh.split()
+        rc, text = run([tool, exact, mesh] + tool_args)
+        print('   ' + text.strip().replace('\n', '\n   '))
+        if rc != 0:
+            return failures + ['%s: %s exited %d' % (name, tool, rc)]
 
     fit_ply = os.path.join(out, 'fit.ply')
     rc, text = run([args.fit_tool, os.path.join(out, 'project.mlp'), '--out', fit_ply] + args.fit_options.split())
@@ -157,8 +168,8 @@ def check_object(args, name):
         status = fit['fit_status']
         shares = ', '.join('%d: %.1f %%' % (s, 100.0 * np.mean(status == s)) for s in np.unique(status))
         print('  fit_status shares (of %d vertices): %s' % (len(status), shares))
-        # Every object pixel is in view by construction (issue 9: vertices without a model 0), so one
-        # without a model means the builder or the visibility lost it (e.g. an edge-on normal).
+        # Every object pixel is in view by construction (and every seen vertex must have a model), so
+        # one without a model means the builder or the visibility lost it (e.g. an edge-on normal).
         obj = read_ply_vertices(os.path.join(out, 'object_pixels.ply'))
         if 'visible' in obj.dtype.names and len(obj) == len(status):
             on_object = obj['visible'] > 0
@@ -169,7 +180,7 @@ def check_object(args, name):
         if not failures:
             failures += sampling_check(args, name, fit, mask)
 
-    # Acceptance (issue 9): over every object pixel (one vertex per pixel) at the held-out lights,
+    # Acceptance: over every object pixel (one vertex per pixel) at the held-out lights,
     # the product below per-pixel PTM and RBF fitted on the same training photos, in mean and p95,
     # and no seen vertex without a model.
     rc, rows, unmodelled = score(args, out, fit_ply)
@@ -242,12 +253,15 @@ def main():
                     help='also fit with these extra options and fail if the defaults relight worse (mean or '
                          'p95 beyond --tolerance), e.g. "--diffuse lambert"')
     ap.add_argument('--tolerance', type=float, default=0.02)
+    ap.add_argument('--perturb-mesh', default='',
+                    help='a tool and its options that write a changed copy of the mesh (TOOL IN OUT ARGS), e.g. '
+                         '"vbrdf_perturb_mesh --smooth-normals 3 --target-median 3.5"')
     ap.add_argument('--decoding-check', choices=('fail', 'warn'), default='fail',
                     help='the grey sphere says whether the decoding is linear; warn: only print it')
     args = ap.parse_args()
     seitz = psm.is_seitz_set(args.data)
     if not seitz and not all(os.path.isfile(os.path.join(args.data, o, 'light_directions.txt')) for o in args.objects):
-        print('SKIP: real photometric-stereo set not found at %s (see the README: it lives in '
+        print('SKIP: real photometric-stereo set not found at %s (see docs/testing.md: it lives in '
               '../shared beside the repository and is not part of it)' % args.data)
         return SKIP
     failures = []

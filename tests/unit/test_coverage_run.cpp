@@ -145,9 +145,8 @@ TEST(LightFile, DefaultIsTheNewestCompleteOne) {
 
 TEST(LightFile, EveryFilterPicksTheSameFileBesideAStaleLightsLp) {
   // An acquisition after an import: the first lights.lp (complete but superseded), the import's
-  // newer <project>_lights.lp, and a still newer .lp that lacks a raster. The fit (which took the
-  // alphabetically first, lights.lp, before issue 10), coverage and the shared rule agree on the
-  // newer complete file. Relight, import and the tools call the same find_default_light_file.
+  // newer <project>_lights.lp, and a still newer .lp that lacks a raster. The fit, coverage and the
+  // shared rule agree on the newer complete file (not the alphabetically first, lights.lp). Relight, import and the tools call the same find_default_light_file.
   const SampleProject sample;
   const std::string dir = test::scratch_dir("lp_policy"), project = dir + "/project.mlp";
   const std::string lights = read_text(sample.project.project_path.substr(0, sample.project.project_path.rfind('/')) +

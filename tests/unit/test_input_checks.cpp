@@ -1,4 +1,4 @@
-// Bad and odd inputs caught before any work (issue 17): photo contents (black, saturated,
+// Bad and odd inputs caught before any work: photo contents (black, saturated,
 // identical), light files with a byte-order mark, CRLF line ends or a photo listed twice, the mesh
 // file's normals, an identity camera.
 #include <fstream>

@@ -90,7 +90,7 @@ TEST(OutputPly, RepeatedExportsInOneProcessStayCorrect) {
 }
 
 namespace {
-// Output files, nothing lost (issue 17): overwrite policy, stale temporaries of killed runs, a
+// Output files, nothing lost: overwrite policy, stale temporaries of killed runs, a
 // file size limit (as a full disk) and a short temporary become errors with the previous file intact.
 void write(const std::string &path, const std::string &text) { std::ofstream(path, std::ios::binary) << text; }
 

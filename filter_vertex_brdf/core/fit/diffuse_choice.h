@@ -54,8 +54,8 @@ struct DiffuseChoice {
 
 struct DiffuseChoiceOptions {
   size_t pilot_vertices = 3000;
-  double margin = 0.10;      // relative improvement coated everywhere must show over Lambert (README
-                             //   "The diffuse term's form")
+  double margin = 0.10;      // relative improvement coated everywhere must show over Lambert
+                             //   (docs/decisions/diffuse_form.md)
   double map_margin = 0.05;  // relative improvement the coat map must show over the uniform choice
 };
 

@@ -22,7 +22,7 @@ namespace {
 // summed over the same vertices for every K, so an even subsample ranks them as the whole mesh
 // does; the materials of the chosen K are then found again on every vertex (fit_materials step 2).
 // On the benchmark's 100 k vertices (45 k eligible) the choice took 1.68 s on all of them, 0.24 s
-// on 3000 (same K and lobes: README "The material stage's cost").
+// on 3000 (same K and lobes: docs/decisions/material_stage.md).
 constexpr size_t kSelectionVertices = 3000;
 Context selection_subsample(const Context &c, size_t eligible) {
   Context sel = c;
@@ -208,7 +208,7 @@ MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &st
   const int merged = merge_twin_materials(sel, S_train.front(), kTrain, fits, mo, configs[chosen]);
   R.chosen_prior = best_choice[chosen].prior;
   R.chosen_alpha_prior = best_choice[chosen].alpha_prior;
-  rep << "materials (issue 16): chosen by held-out error (every 4th photo left out, fitted on the others";
+  rep << "materials: chosen by held-out error (every 4th photo left out, fitted on the others";
   if (n_folds > 1)
     rep << "; " << photos << " photos (fewer than " << mo.pool_folds_below << "): summed over " << n_folds
         << " such splits, until at least " << mo.min_heldout_photos << " photos were held out";

@@ -1,5 +1,5 @@
 #pragma once
-// Materials found from the data, and a specular lobe per material (issue 16, first step).
+// Material stage: materials found from the data, and a specular lobe per material.
 //
 // After the per-vertex Phong fit, the modelled vertices are grouped into a few materials by their
 // specular response, a lobe (k_s, alpha on the fit's lobe cosine, R.E or N.H) is fitted per material from the pooled samples of
@@ -114,10 +114,10 @@ struct MaterialOptions {
   // camera -5.0 % (-13.0), bunny's glossy material -2.7 % (-12.9), the 100 k benchmark scene -14.5 %
   // (-6.1), synth_linear16's three glossy materials -24 / -64 / -24 % (-3.2 / -3.4 / -3.8): given;
   // teapot -0.7 % (-2.6), the Harvard frog's two glossy materials +0.9 % and -1.2 % (+1.3, -0.6),
-  // the benchmark grid's reference +4.8 % and +8.7 % (+10.5, +2.1): not given. A sum of squared
-  // linear-RGB residuals (the test until 2026-12-04) gave that reference's broad lobe (-73 %) and so
-  // raised its relit error (whole surface 0.890 -> 0.958, albedo 1.24 -> 2.12 CIEDE2000): the
-  // lobe lowered the highlights' squared error and lit the dark grazing-light pixels (N.L < 0.1:
+  // the benchmark grid's reference +4.8 % and +8.7 % (+10.5, +2.1): not given. Judged instead by a
+  // sum of squared linear-RGB residuals, the test gives that reference's broad lobe (-73 %) and so
+  // raises its relit error (whole surface 0.890 -> 0.958, albedo 1.24 -> 2.12 CIEDE2000): the lobe
+  // lowers the highlights' squared error and lights the dark grazing-light pixels (N.L < 0.1:
   // 1.95 -> 9.61), which squared errors hardly weigh and the fits never see.
   float min_giving_gain = 0.02f;
   float giving_confidence = 2.0f;

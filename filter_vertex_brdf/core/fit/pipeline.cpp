@@ -220,7 +220,7 @@ void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOption
   fit_seconds += seconds_since(t);
 }
 
-// Material stage hook (materials.h, issue 16): after the per-vertex fit of every chunk, before the
+// Material stage hook (materials.h): after the per-vertex fit of every chunk, before the
 // neighbour fill (which then copies the material-consistent parameters).
 void run_material_stage(const FitInput &input, const FitSettings &settings, const MaterialSampleStore &store,
                         const LogFn &log, FitResult &r) {
@@ -543,7 +543,7 @@ FitResult run_fit(const FitInput &given, const FitSettings &settings_in, Visibil
   if (settings.fit_reflectance) result.fits.resize(mesh.vertex_count);
   LightAgreement agreement(input.rasters.size());  // a light file that contradicts the photos fails below
   const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
-  const bool with_materials = settings.fit_reflectance && settings.materials;  // material stage hook (issue 16)
+  const bool with_materials = settings.fit_reflectance && settings.materials;  // material stage hook
   MaterialSampleStore material_samples(with_materials ? mesh.vertex_count : 0);
   const NormalStep refine_normals = settings.fit_reflectance && settings.shading_normals.enabled
                                         ? shading_normal_refiner(input, lights, settings, result)

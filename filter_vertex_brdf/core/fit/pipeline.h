@@ -34,18 +34,18 @@ enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
 // The fit's T_d (N.L below which a sample is "grazing"): 0.2, not the thesis's 0.5. With errors
 // weighted by N.L, grazing samples help more than they hurt: over the whole visible surface the
 // held-out error falls on every shared scene as T_d goes from 0.5 to 0.2 (spot_dir24 1.16 -> 1.12,
-// bunny 0.98 -> 0.96, teapot 1.63 -> 1.57 mean CIEDE2000; README, "The whole visible surface"),
+// bunny 0.98 -> 0.96, teapot 1.63 -> 1.57 mean CIEDE2000; docs/decisions/whole_surface.md),
 // and little more below. Coverage keeps 0.5: it asks the photographer for well-lit samples.
 constexpr float kFitDiffuseThreshold = 0.2f;
 
-// The product's lobe form (the filter's and vbrdf_fit's default; README "The lobe's form and several
-// cameras" has the measurements that chose it). PhongFitOptions keeps the thesis's R.E as the
-// core contract's default; the pipeline copies phong.lobe into gather.lobe.
+// The product's lobe form (the filter's and vbrdf_fit's default; docs/decisions/ggx_lobe.md has the
+// measurements that chose it). PhongFitOptions keeps the thesis's R.E as the core contract's
+// default; the pipeline copies phong.lobe into gather.lobe.
 constexpr LobeForm kFitLobe = LobeForm::GgxNH;
 
 // How the fit's diffuse form (diffuse_form.h) is decided. Auto (the product's default): a pilot fit
-// on each form with photos held out picks it per scene (diffuse_choice.h; README "The diffuse
-// term's form" has the measurements behind it); Lambert / Coated: as given.
+// on each form with photos held out picks it per scene (diffuse_choice.h;
+// docs/decisions/diffuse_form.md has the measurements behind it); Lambert / Coated: as given.
 enum class DiffuseTermChoice { Auto = 0, Lambert = 1, Coated = 2 };
 constexpr DiffuseTermChoice kFitDiffuseChoice = DiffuseTermChoice::Auto;
 
@@ -79,10 +79,10 @@ struct FitSettings {
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
   // (neighbour_fill.h); 0 = off. Seen vertices without a usable sample are always filled.
   int fill_unseen_rings = 0;
-  // Material stage (materials.h, issue 16): materials found from the data, a lobe per material
+  // Material stage (materials.h): materials found from the data, a lobe per material
   // from the pooled samples, every vertex of a glossy material with a specular term where the
   // held-out photos show it helps. CPU, after either fit back end. Keeps the usable (and grazing)
-  // samples in memory (28 bytes each) until the stage ran. On by default since 2026-12-04.
+  // samples in memory (28 bytes each) until the stage ran. On by default.
   bool materials = true;
   MaterialOptions material_options;
   // Samples far darker than their vertex's model although the mesh lets the light reach them
@@ -92,7 +92,7 @@ struct FitSettings {
   // albedo edge (fit/albedo_deconvolution.h): each vertex's own albedo instead of the footprint's
   // blend of its neighbours' (sharp material boundaries and painted lines). The result's
   // diffuse_deconvolved = 1 marks those vertices; the relighting evaluation predicts photos there
-  // through the same footprints. Phong fit only. On by default since 2026-12-04 (README "Tenth step").
+  // through the same footprints. Phong fit only. On by default.
   bool deconvolve_albedo = true;
   DeconvolutionSettings deconvolution;
   // Each viewpoint's camera measured against its photos and corrected where it is off by more than

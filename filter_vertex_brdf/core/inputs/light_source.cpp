@@ -145,7 +145,7 @@ std::vector<LightSource> from_json(const std::vector<Raster> &rasters, const std
   const cv::FileNode images_node = root["images"];
   if (images_node.empty() || !images_node.isSeq())
     throw InputError("Light file '" + path + "' has no \"images\" list: a light-position file names each photo "
-                     "(README, \"Lights\").");
+                     "(docs/parameters.md#near-lights-light-positions).");
   std::vector<std::string> images;
   for (size_t i = 0; i < images_node.size(); ++i) images.push_back(std::string(images_node[int(i)]));
   const bool world = !root["position_world"].empty();

@@ -62,7 +62,7 @@ struct LightPlacement {
 // The placement of a mesh: its bounding box, dome radius and unit scale as given.
 LightPlacement light_placement_of(const MeshView &mesh, float dome_radius, float unit_scale);
 
-// Reads the lights of every raster from `path`, in one of three forms (README "Lights"):
+// Reads the lights of every raster from `path`, in one of three forms (docs/parameters.md#light-file):
 //  - RTI .lp (RTIBuilder / Relight): per photo a direction in its camera frame. Directional, or
 //    point lights on a dome when placement.dome_radius > 0.
 //  - .json (our plain form): {"images": [...], "position_world": [[x,y,z], ...]} in the mesh's

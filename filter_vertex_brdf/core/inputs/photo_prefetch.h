@@ -1,6 +1,6 @@
 #pragma once
 // Decodes a project's photos in the background while the GL passes run, so that the sample
-// gathering finds them decoded (issue 13): worker threads fill the PhotoCache in raster order, up
+// gathering finds them decoded: worker threads fill the PhotoCache in raster order, up
 // to its memory budget. Errors are kept and raised, naming the photo, when the caller asks.
 #include <atomic>
 #include <cstddef>

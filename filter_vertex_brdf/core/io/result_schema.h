@@ -5,7 +5,8 @@
 // cannot feed one attribute's values to another.
 //
 // File order is the table's order (diffuse_r ... coloured, then the Phong fit's kd ...
-// fit_iterations); keep it: existing result files, tools and the README table follow it.
+// fit_iterations); keep it: existing result files, tools and the README table (README.md#output)
+// follow it.
 // Every attribute is stored as a 32-bit float.
 #include <map>
 #include <string>

@@ -38,7 +38,7 @@ struct AlignmentSettings {
   std::vector<double> levels = {3.0, 1.5, 0.75};
   int iterations = 12;       // Gauss-Newton steps per level at most
   // Normal residual (unit vectors) beyond which a point's weight falls as 1/r: 0.1 keeps the estimate
-  // on exact cameras within 0.07 px on the shared scenes (0.3: 0.11 px; README "Cameras a pixel off").
+  // on exact cameras within 0.07 px on the shared scenes (0.3: 0.11 px; docs/benchmark.md#real-captures-cameras-off-and-smoothed-normals).
   double huber = 0.1;
   // Roll and scale are kept only where the data determine them: each must exceed this many of its
   // standard deviations and move the points by at least min_effect_px (RMS); else it stays 0.

@@ -26,11 +26,12 @@ namespace vbrdf {
 
 struct RegistrationSettings {
   // Off by default: on the synthetic sample projects, whose cameras are exact, the measurement
-  // reads 1.2-1.3 px (README "Cameras a pixel off"); until that is understood it is the user's choice.
+  // reads 1.2-1.3 px (docs/method.md#registration-refined-from-the-photos); until that is understood it
+  // is the user's choice.
   bool enabled = false;
   // A viewpoint whose measured misregistration (RMS displacement of its visible vertices, pixels)
-  // is below this keeps its camera: the estimate on exact cameras stays under it (README,
-  // "Cameras a pixel off").
+  // is below this keeps its camera: the estimate on exact cameras stays under it
+  // (docs/benchmark.md#real-captures-cameras-off-and-smoothed-normals).
   float threshold_px = 0.25f;
   // Beyond this the registration is not "a pixel or two off" and no local refinement is trusted:
   // the camera is kept and a warning asks for a registration in MeshLab.

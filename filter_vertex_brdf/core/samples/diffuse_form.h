@@ -15,7 +15,7 @@
 // Why the clamp, on both sides: a real coat is rough, and a rough coat transmits much more at
 // grazing angles than a smooth one (the shared scenes' GGX coats: 0.70 of the head-on value at 85
 // degrees where a smooth coat gives 0.41). T(max(cos, 0.2)) follows the rough coats' curves within
-// 0.04-0.18 from 0 to 85 degrees. Measured (README "The diffuse term's form", tests/benchmark/
+// 0.04-0.18 from 0 to 85 degrees. Measured (docs/decisions/diffuse_form.md, tests/benchmark/
 // oracle_eval.py): with the true albedo and lobe, clamping the light side too cut the spot pair's
 // clean-pixel error from 0.76 to 0.66; in the fit, 0.2 beat 0.15, 0.25 and 0.3 over the spot pair
 // and the bunny and teapot scenes together.

@@ -9,7 +9,7 @@
 //            the usual Phong-equivalent exponent of that roughness (alpha = 2/a^2 - 2, the shared
 //            scenes' `phong_shininess_approx`). Same peak curvature family, but the long tails of
 //            real highlights: with the true parameters it predicts the spot pair's clean pixels at
-//            0.62 / 0.59 against Blinn-Phong's 0.83 / 0.84 (README "What the true reflectance scores").
+//            0.62 / 0.59 against Blinn-Phong's 0.83 / 0.84 (docs/decisions/true_reflectance.md).
 // E is the unit vector from the surface point to the camera centre, L towards the light.
 // Every stage that evaluates the lobe (the gatherer's Sample::lobe_cos, the CPU and GPU fits, the
 // material stage, the relight renderer and the sample-based evaluation) takes the cosine from

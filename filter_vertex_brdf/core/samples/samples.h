@@ -105,7 +105,7 @@ struct GatherSettings {
   DiffuseForms diffuse;
   // Weight samples by their photo's resolution of the vertex (Sample::resolution); false: every
   // code 0 (all photos alike). Off by default: on the spot pair the two-camera fit scored worse
-  // with it (README "The lobe's form and several cameras").
+  // with it (docs/decisions/lobe_half_angle.md).
   bool resolution_weights = false;
   // Fill Sample::footprint (the normal variance over the photo's pixel footprint, footprint.h) for
   // the GGX lobe; false, or another lobe form: every footprint 0 (the lobe at the vertex alone).

@@ -10,7 +10,7 @@
 //  - RBF as in CNR-ISTI Relight: Gaussian kernel on the angle between light directions,
 //      k(theta) = exp(-(theta / sigma)^2),
 //    the form of Relight's RtiBuilder::buildResampleMap (exp(-d^2 / sigma^2) on the distance
-//    between unit directions; here on the angle, as the issue specifies), sigma = mean over the
+//    between unit directions; here on the angle, as k(theta) above states), sigma = mean over the
 //    training lights of the angle to the nearest other training light, ridge lambda:
 //      (K + lambda I) w = y per channel,   f(l) = sum_i w_i k(angle(l, l_i)).
 //    This plain kernel falls towards black far from sparse training lights.

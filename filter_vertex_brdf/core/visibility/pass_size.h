@@ -23,7 +23,8 @@
 //    (a band <= d pixels wide) or on steep faces are reported as not own that a photo-resolution
 //    pass would call own: their samples become rim samples (used where a vertex has < 2 clean).
 //    kCameraPixelsPerEdge is 3 (d = 2 from 6-pixel edges): at 1.5 the 1 M-vertex benchmark at
-//    4000x3000 (3.2-pixel edges, d = 2) raised the albedo error from 0.46 to 0.59 (README).
+//    4000x3000 (3.2-pixel edges, d = 2) raised the albedo error from 0.46 to 0.59
+//    (docs/decisions/visibility_and_speed.md).
 #include <string>
 #include <vector>
 
