@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
@@ -16,20 +17,35 @@ void warp_rotation(const ImageWarp &w, double out[3][3]) {
     for (int j = 0; j < 3; ++j) out[i][j] = R(i, j);
 }
 
-void warp_point(const ImageWarp &w, const double c[2], double f, const double p[2], double out[2]) {
+namespace {
+
+// A warp with its rotation and scale computed once, applied to many points.
+struct PreparedWarp {
   double R[3][3];
-  warp_rotation(w, R);
-  const double d[3] = {(p[0] - c[0]) / f, (p[1] - c[1]) / f, 1.0};
-  double e[3];
-  for (int i = 0; i < 3; ++i) e[i] = R[i][0] * d[0] + R[i][1] * d[1] + R[i][2] * d[2];
-  // A ray turned behind the camera (never for the fractions of a degree refined) keeps its point.
-  if (!(e[2] > 1e-6)) {
-    out[0] = p[0], out[1] = p[1];
-    return;
+  double c[2];
+  double f, s;
+  PreparedWarp(const ImageWarp &w, const double centre[2], double focal) : c{centre[0], centre[1]}, f(focal) {
+    warp_rotation(w, R);
+    s = std::exp(w.log_scale) * f;
   }
-  const double s = std::exp(w.log_scale) * f;
-  out[0] = c[0] + s * e[0] / e[2];
-  out[1] = c[1] + s * e[1] / e[2];
+  void apply(const double p[2], double out[2]) const {
+    const double d[3] = {(p[0] - c[0]) / f, (p[1] - c[1]) / f, 1.0};
+    double e[3];
+    for (int i = 0; i < 3; ++i) e[i] = R[i][0] * d[0] + R[i][1] * d[1] + R[i][2] * d[2];
+    // A ray turned behind the camera (never for the fractions of a degree refined) keeps its point.
+    if (!(e[2] > 1e-6)) {
+      out[0] = p[0], out[1] = p[1];
+      return;
+    }
+    out[0] = c[0] + s * e[0] / e[2];
+    out[1] = c[1] + s * e[1] / e[2];
+  }
+};
+
+} // namespace
+
+void warp_point(const ImageWarp &w, const double c[2], double f, const double p[2], double out[2]) {
+  PreparedWarp(w, c, f).apply(p, out);
 }
 
 namespace {
@@ -100,17 +116,22 @@ double huber_cost(double r, double k) { return r <= k ? 0.5 * r * r : k * (r - 0
 
 // Mean robust cost over the points that land on determined pixels, and their count.
 double cost_of(const Problem &pb, const Level &l, const ImageWarp &s, size_t &used) {
+  const PreparedWarp warp(s, pb.c, pb.f);
   double sum = 0;
-  used = 0;
-  for (const AlignmentPoint &p : pb.points) {
+  long count = 0;
+  const long n = long(pb.points.size());
+#pragma omp parallel for reduction(+ : sum, count) schedule(static)
+  for (long i = 0; i < n; ++i) {
+    const AlignmentPoint &p = pb.points[size_t(i)];
     const double p0[2] = {p.x, p.y};
     double q[2];
-    warp_point(s, pb.c, pb.f, p0, q);
-    Eigen::Vector3d n;
-    if (!sample_level(l, q[0], q[1], n)) continue;
-    sum += huber_cost((n - Eigen::Vector3d(p.n[0], p.n[1], p.n[2])).norm(), pb.settings.huber);
-    ++used;
+    warp.apply(p0, q);
+    Eigen::Vector3d m;
+    if (!sample_level(l, q[0], q[1], m)) continue;
+    sum += huber_cost((m - Eigen::Vector3d(p.n[0], p.n[1], p.n[2])).norm(), pb.settings.huber);
+    ++count;
   }
+  used = size_t(count);
   return used ? sum / double(used) : 0.0;
 }
 
@@ -128,39 +149,65 @@ struct NormalEquations {
 // J^T W J and J^T W r of the free parameters `param` (count n) at warp w; the map's derivative by
 // central differences of the bilinear sample half a pixel apart.
 NormalEquations normal_equations(const Problem &pb, const Level &l, const ImageWarp &w, const int *param, int n) {
+  const PreparedWarp warp(w, pb.c, pb.f);
+  // Each parameter's warps half a finite-difference step either side, a hundredth of a pixel's
+  // effect apart, prepared once for every point.
+  std::vector<PreparedWarp> plus, minus;
+  std::vector<double> step;
+  for (int i = 0; i < n; ++i) {
+    const double h = 0.01 / pixels_per_unit(pb, param[i]);
+    ImageWarp up = w, down = w;
+    parameter(up, param[i]) += h;
+    parameter(down, param[i]) -= h;
+    plus.emplace_back(up, pb.c, pb.f);
+    minus.emplace_back(down, pb.c, pb.f);
+    step.push_back(h);
+  }
   NormalEquations ne;
   ne.H = Eigen::MatrixXd::Zero(n, n);
   ne.g = Eigen::VectorXd::Zero(n);
-  for (const AlignmentPoint &p : pb.points) {
-    const double p0[2] = {p.x, p.y};
-    double q[2];
-    warp_point(w, pb.c, pb.f, p0, q);
-    Eigen::Vector3d n0, nx0, nx1, ny0, ny1;
-    if (!sample_level(l, q[0], q[1], n0) || !sample_level(l, q[0] - 0.5, q[1], nx0) ||
-        !sample_level(l, q[0] + 0.5, q[1], nx1) || !sample_level(l, q[0], q[1] - 0.5, ny0) ||
-        !sample_level(l, q[0], q[1] + 0.5, ny1))
-      continue;
-    const Eigen::Vector3d r = n0 - Eigen::Vector3d(p.n[0], p.n[1], p.n[2]);
-    const double weight = huber_weight(r.norm(), pb.settings.huber);
-    Eigen::Matrix<double, 3, 2> dn;
-    dn.col(0) = nx1 - nx0;
-    dn.col(1) = ny1 - ny0;
-    // d(warped point) / d(parameter) by central differences, a hundredth of a pixel's effect apart.
+  const long count = long(pb.points.size());
+#pragma omp parallel
+  {
+    NormalEquations part;
+    part.H = Eigen::MatrixXd::Zero(n, n);
+    part.g = Eigen::VectorXd::Zero(n);
     Eigen::MatrixXd J(3, n);
-    for (int i = 0; i < n; ++i) {
-      const double h = 0.01 / pixels_per_unit(pb, param[i]);
-      ImageWarp plus = w, minus = w;
-      parameter(plus, param[i]) += h;
-      parameter(minus, param[i]) -= h;
-      double qp[2], qm[2];
-      warp_point(plus, pb.c, pb.f, p0, qp);
-      warp_point(minus, pb.c, pb.f, p0, qm);
-      J.col(i) = dn * Eigen::Vector2d((qp[0] - qm[0]) / (2 * h), (qp[1] - qm[1]) / (2 * h));
+#pragma omp for schedule(static) nowait
+    for (long k = 0; k < count; ++k) {
+      const AlignmentPoint &p = pb.points[size_t(k)];
+      const double p0[2] = {p.x, p.y};
+      double q[2];
+      warp.apply(p0, q);
+      Eigen::Vector3d n0, nx0, nx1, ny0, ny1;
+      if (!sample_level(l, q[0], q[1], n0) || !sample_level(l, q[0] - 0.5, q[1], nx0) ||
+          !sample_level(l, q[0] + 0.5, q[1], nx1) || !sample_level(l, q[0], q[1] - 0.5, ny0) ||
+          !sample_level(l, q[0], q[1] + 0.5, ny1))
+        continue;
+      const Eigen::Vector3d r = n0 - Eigen::Vector3d(p.n[0], p.n[1], p.n[2]);
+      const double weight = huber_weight(r.norm(), pb.settings.huber);
+      Eigen::Matrix<double, 3, 2> dn;
+      dn.col(0) = nx1 - nx0;
+      dn.col(1) = ny1 - ny0;
+      for (int i = 0; i < n; ++i) {
+        double qp[2], qm[2];
+        plus[size_t(i)].apply(p0, qp);
+        minus[size_t(i)].apply(p0, qm);
+        const double h = step[size_t(i)];
+        J.col(i) = dn * Eigen::Vector2d((qp[0] - qm[0]) / (2 * h), (qp[1] - qm[1]) / (2 * h));
+      }
+      part.H += weight * J.transpose() * J;
+      part.g += weight * J.transpose() * r;
+      part.residual_sq += weight * r.squaredNorm();
+      ++part.used;
     }
-    ne.H += weight * J.transpose() * J;
-    ne.g += weight * J.transpose() * r;
-    ne.residual_sq += weight * r.squaredNorm();
-    ++ne.used;
+#pragma omp critical
+    {
+      ne.H += part.H;
+      ne.g += part.g;
+      ne.residual_sq += part.residual_sq;
+      ne.used += part.used;
+    }
   }
   return ne;
 }

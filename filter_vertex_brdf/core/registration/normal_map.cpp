@@ -30,7 +30,8 @@ PixelNormal solve_pixel(const std::vector<float> &I, const std::vector<Eigen::Ve
   }
   PixelNormal out;
   if (n < s.min_samples) return out;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(A / n, Eigen::EigenvaluesOnly);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(A / n, Eigen::EigenvaluesOnly);  // closed form: this runs once per pixel and round
   if (!(eig.eigenvalues()(0) >= s.min_light_spread)) return out;
   out.b = A.ldlt().solve(y);
   out.determined = out.b.allFinite();

@@ -131,6 +131,39 @@ double light_spread(const std::vector<std::array<float, 3>> &dirs) {
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(A / double(dirs.size()), Eigen::EigenvaluesOnly).eigenvalues()(0);
 }
 
+// At most `count` of the viewpoint's photos (indices into `dirs`), their lights spread as evenly as
+// they allow: farthest-point order from the light nearest the mean direction. Photometric stereo
+// determines a normal from a handful of well-spread lights; more photos cost time, not accuracy.
+std::vector<size_t> spread_photos(const std::vector<std::array<float, 3>> &dirs, size_t count) {
+  std::vector<size_t> chosen;
+  if (count == 0 || dirs.size() <= count) {
+    for (size_t k = 0; k < dirs.size(); ++k) chosen.push_back(k);
+    return chosen;
+  }
+  std::vector<Eigen::Vector3d> l;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto &d : dirs) {
+    l.push_back(Eigen::Vector3d(d[0], d[1], d[2]).normalized());
+    mean += l.back();
+  }
+  size_t first = 0;
+  for (size_t k = 1; k < l.size(); ++k)
+    if (l[k].dot(mean) > l[first].dot(mean)) first = k;
+  chosen.push_back(first);
+  std::vector<double> nearest(l.size(), 4.0);  // squared distance to the nearest chosen light
+  while (chosen.size() < count) {
+    const Eigen::Vector3d &last = l[chosen.back()];
+    size_t next = 0;
+    for (size_t k = 0; k < l.size(); ++k) {
+      nearest[k] = std::min(nearest[k], (l[k] - last).squaredNorm());
+      if (nearest[k] > nearest[next]) next = k;
+    }
+    chosen.push_back(next);
+  }
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
+}
+
 // Measures one viewpoint at `shot` against its normal map: the warp and the points used.
 AlignmentResult measure(const std::vector<AlignmentPoint> &points, const NormalMap &map, const Shot &shot,
                         const AlignmentSettings &settings) {
@@ -151,14 +184,18 @@ ViewpointRegistration register_viewpoint(const MeshView &mesh, const std::vector
     out.not_measured = "fewer than " + std::to_string(settings.min_photos) + " photos (photometric stereo needs them)";
     return out;
   }
-  std::vector<std::array<float, 3>> dirs;
+  std::vector<std::array<float, 3>> all_dirs;
   for (size_t r : vp.rasters) {
     if (lights[r].positional) {
       out.not_measured = "its lights are point lights (the normal map needs one direction per photo)";
       return out;
     }
-    dirs.push_back(lights[r].direction);
+    all_dirs.push_back(lights[r].direction);
   }
+  const std::vector<size_t> used_photos = spread_photos(all_dirs, settings.max_photos);
+  std::vector<std::array<float, 3>> dirs;
+  for (size_t k : used_photos) dirs.push_back(all_dirs[k]);
+  out.map_photos = used_photos.size();
   if (light_spread(dirs) < settings.normal_map.min_light_spread) {
     out.not_measured = "its lights lie nearly in one plane (the normals are not determined)";
     return out;
@@ -171,8 +208,8 @@ ViewpointRegistration register_viewpoint(const MeshView &mesh, const std::vector
   }
   const cv::Rect region = region_of(points, vp.shot, settings);
   std::vector<cv::Mat> lum;
-  for (size_t r : vp.rasters) {
-    const Raster &raster = rasters[r];
+  for (size_t k : used_photos) {
+    const Raster &raster = rasters[vp.rasters[k]];
     lum.push_back(luminance_of(*photos.get(raster.image_path, raster.width(), raster.height()), region));
   }
   const NormalMap map = photometric_normal_map(lum, dirs, region, settings.normal_map);
@@ -220,6 +257,8 @@ std::string describe_registration(const ViewpointRegistration &v, const Registra
   std::string s = "viewpoint '" + v.label + "' (" + std::to_string(v.rasters.size()) + " photos): ";
   if (!v.measured) return s + "not measured, " + v.not_measured + "; camera unchanged";
   s += "misregistration " + fixed(v.before_px) + " px over " + std::to_string(v.points) + " vertices";
+  if (v.map_photos < v.rasters.size())
+    s += " (normal map from " + std::to_string(v.map_photos) + " photos, their lights spread evenly)";
   if (v.too_large)
     return s + ", beyond the " + fixed(settings.max_correction_px, 1) +
            " px this refines: camera unchanged (register the photos to the mesh again in MeshLab)";
