@@ -264,11 +264,12 @@ Eigen::VectorXd parameter_sigma(const Problem &pb, const Level &l, const ImageWa
 
 double rms_displacement(const std::vector<AlignmentPoint> &points, const double c[2], double f, const ImageWarp &w) {
   if (points.empty()) return 0;
+  const PreparedWarp warp(w, c, f);
   double sum = 0;
   for (const AlignmentPoint &p : points) {
     const double p0[2] = {p.x, p.y};
     double q[2];
-    warp_point(w, c, f, p0, q);
+    warp.apply(p0, q);
     sum += (q[0] - p0[0]) * (q[0] - p0[0]) + (q[1] - p0[1]) * (q[1] - p0[1]);
   }
   return std::sqrt(sum / double(points.size()));
