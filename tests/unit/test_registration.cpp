@@ -9,6 +9,10 @@
 #include <string>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "inputs/light_source.h"
@@ -211,6 +215,30 @@ TEST(Registration, RecoversARollOfTheCamera) {
   EXPECT_TRUE(v.roll_determined);
   EXPECT_NEAR(v.correction.roll, -turn.roll, 0.25 * turn.roll);
   EXPECT_LT(rms_between(c.mesh, r.rasters[0].shot, c.truth), 0.12);
+}
+
+// The correction is the same to the bit whatever the thread count: the alignment's sums are added
+// in a fixed order, so a registered result can be compared byte for byte with another run.
+TEST(Registration, CorrectionIsTheSameWhateverTheThreadCount) {
+#ifndef _OPENMP
+  GTEST_SKIP() << "built without OpenMP: one thread only";
+#else
+  const SphereCapture c = render_sphere(test::scratch_dir("registration_threads"));
+  const Shot given = shifted(c.truth, 1.2f, -0.7f);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const RegistrationResult one = refine(c, given);
+  omp_set_num_threads(3);
+  const RegistrationResult three = refine(c, given);
+  omp_set_num_threads(threads);
+  const ViewpointRegistration &a = one.viewpoints.at(0), &b = three.viewpoints.at(0);
+  ASSERT_TRUE(a.applied);
+  EXPECT_EQ(a.correction.pitch, b.correction.pitch);
+  EXPECT_EQ(a.correction.yaw, b.correction.yaw);
+  EXPECT_EQ(a.correction.roll, b.correction.roll);
+  EXPECT_EQ(a.correction.log_scale, b.correction.log_scale);
+  EXPECT_EQ(a.after_px, b.after_px);
+#endif
 }
 
 // Exact cameras stay as they are (nothing to correct: below the threshold), bit for bit.

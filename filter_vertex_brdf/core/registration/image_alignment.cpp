@@ -114,25 +114,48 @@ double pixels_per_unit(const Problem &pb, int i) { return i < 2 ? pb.f : pb.radi
 double huber_weight(double r, double k) { return r <= k ? 1.0 : k / r; }
 double huber_cost(double r, double k) { return r <= k ? 0.5 * r * r : k * (r - 0.5 * k); }
 
+// Sums over points 0..n-1 in kSumBlocks fixed blocks, each block's partial added in block order:
+// the same bits whatever the thread count or schedule (a reduction or a critical section adds
+// partials in the order threads finish). add_block(part, begin, end) accumulates one block.
+constexpr long kSumBlocks = 64;
+
+template <class Part, class AddBlock>
+Part sum_in_blocks(long n, const Part &zero, AddBlock add_block) {
+  std::vector<Part> parts(size_t(kSumBlocks), zero);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long b = 0; b < kSumBlocks; ++b) add_block(parts[size_t(b)], n * b / kSumBlocks, n * (b + 1) / kSumBlocks);
+  Part total = zero;
+  for (const Part &part : parts) total += part;
+  return total;
+}
+
+struct CostSum {
+  double sum = 0;
+  size_t count = 0;
+  CostSum &operator+=(const CostSum &o) {
+    sum += o.sum;
+    count += o.count;
+    return *this;
+  }
+};
+
 // Mean robust cost over the points that land on determined pixels, and their count.
 double cost_of(const Problem &pb, const Level &l, const ImageWarp &s, size_t &used) {
   const PreparedWarp warp(s, pb.c, pb.f);
-  double sum = 0;
-  long count = 0;
-  const long n = long(pb.points.size());
-#pragma omp parallel for reduction(+ : sum, count) schedule(static)
-  for (long i = 0; i < n; ++i) {
-    const AlignmentPoint &p = pb.points[size_t(i)];
-    const double p0[2] = {p.x, p.y};
-    double q[2];
-    warp.apply(p0, q);
-    Eigen::Vector3d m;
-    if (!sample_level(l, q[0], q[1], m)) continue;
-    sum += huber_cost((m - Eigen::Vector3d(p.n[0], p.n[1], p.n[2])).norm(), pb.settings.huber);
-    ++count;
-  }
-  used = size_t(count);
-  return used ? sum / double(used) : 0.0;
+  const CostSum total = sum_in_blocks(long(pb.points.size()), CostSum(), [&](CostSum &part, long begin, long end) {
+    for (long i = begin; i < end; ++i) {
+      const AlignmentPoint &p = pb.points[size_t(i)];
+      const double p0[2] = {p.x, p.y};
+      double q[2];
+      warp.apply(p0, q);
+      Eigen::Vector3d m;
+      if (!sample_level(l, q[0], q[1], m)) continue;
+      part.sum += huber_cost((m - Eigen::Vector3d(p.n[0], p.n[1], p.n[2])).norm(), pb.settings.huber);
+      ++part.count;
+    }
+  });
+  used = total.count;
+  return used ? total.sum / double(used) : 0.0;
 }
 
 void add_step(ImageWarp &w, const Eigen::VectorXd &d, const int *param) {
@@ -144,6 +167,14 @@ struct NormalEquations {
   Eigen::VectorXd g;
   double residual_sq = 0;  // weighted squared residuals
   size_t used = 0;
+  explicit NormalEquations(int n) : H(Eigen::MatrixXd::Zero(n, n)), g(Eigen::VectorXd::Zero(n)) {}
+  NormalEquations &operator+=(const NormalEquations &o) {
+    H += o.H;
+    g += o.g;
+    residual_sq += o.residual_sq;
+    used += o.used;
+    return *this;
+  }
 };
 
 // J^T W J and J^T W r of the free parameters `param` (count n) at warp w; the map's derivative by
@@ -163,18 +194,9 @@ NormalEquations normal_equations(const Problem &pb, const Level &l, const ImageW
     minus.emplace_back(down, pb.c, pb.f);
     step.push_back(h);
   }
-  NormalEquations ne;
-  ne.H = Eigen::MatrixXd::Zero(n, n);
-  ne.g = Eigen::VectorXd::Zero(n);
-  const long count = long(pb.points.size());
-#pragma omp parallel
-  {
-    NormalEquations part;
-    part.H = Eigen::MatrixXd::Zero(n, n);
-    part.g = Eigen::VectorXd::Zero(n);
+  auto add_block = [&](NormalEquations &part, long begin, long end) {
     Eigen::MatrixXd J(3, n);
-#pragma omp for schedule(static) nowait
-    for (long k = 0; k < count; ++k) {
+    for (long k = begin; k < end; ++k) {
       const AlignmentPoint &p = pb.points[size_t(k)];
       const double p0[2] = {p.x, p.y};
       double q[2];
@@ -201,15 +223,8 @@ NormalEquations normal_equations(const Problem &pb, const Level &l, const ImageW
       part.residual_sq += weight * r.squaredNorm();
       ++part.used;
     }
-#pragma omp critical
-    {
-      ne.H += part.H;
-      ne.g += part.g;
-      ne.residual_sq += part.residual_sq;
-      ne.used += part.used;
-    }
-  }
-  return ne;
+  };
+  return sum_in_blocks(long(pb.points.size()), NormalEquations(n), add_block);
 }
 
 // Levenberg-Marquardt on the parameters `param`; returns the iterations taken.
