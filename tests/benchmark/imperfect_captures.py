@@ -14,6 +14,7 @@ RBF fitted on the same training photos (per pixel: no camera and no mesh, so nei
 Prints one row per scene x capture x correction: relit CIEDE2000 mean / p95, PTM and RBF on the
 same samples, the misregistration the fit measured (camera captures) or how far the normals moved
 (median degrees), and the fit's run time. The exact capture runs with both steps on (the product).
+Environment: VBRDF_FIT_OPTIONS, further vbrdf_fit options for every fit (e.g. "--deconvolve off").
 --max-ratio: exit 1 unless every perturbed capture with its correction on is within that ratio of
 the exact capture's mean and p95 and below PTM and RBF in both. Skips (exit 0) without the shared
 scenes.
@@ -22,6 +23,7 @@ import argparse
 import csv
 import os
 import re
+import shlex
 import subprocess
 import sys
 import time
@@ -94,6 +96,7 @@ def main():
     work = args.work or os.path.join(args.build, "imperfect_captures")
     os.makedirs(work, exist_ok=True)
     captures = [c for c in CAPTURES if not args.captures or c[0] in args.captures]
+    extra_fit_options = shlex.split(os.environ.get("VBRDF_FIT_OPTIONS", ""))
     rows, failures = [], []
     print(f"{'scene':28} {'capture':16} {'correction':19} {'mean':>6} {'p95':>6}   {'PTM':>13} {'RBF':>13}  {'measured':>14}  fit s")
     for scene in args.scenes:
@@ -121,7 +124,8 @@ def main():
                 out = os.path.join(work, f"{tag}_{step or 'both'}{setting}.ply")
                 rc, secs = run([fit, project, "--lp", os.path.join(s, "lights.lp"), "--photo-dir", os.path.join(s, "linear"),
                                 "--color-correction", "off", "--registration", steps["registration"],
-                                "--shading-normals", steps["shading-normals"], "--out", out], out + ".fit.log")
+                                "--shading-normals", steps["shading-normals"], "--out", out] + extra_fit_options,
+                               out + ".fit.log")
                 if rc != 0:
                     failures.append(f"{scene} {name}: vbrdf_fit failed (see {out}.fit.log)")
                     continue
