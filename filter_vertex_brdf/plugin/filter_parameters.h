@@ -26,7 +26,7 @@
 
 #include "core/calibration/color_chart.h"
 #include "core/inputs/photo.h"
-#include "core/fit/pipeline.h"
+#include "core/run/fit_run.h"
 #include "core/samples/samples.h"
 #include "core/calibration/sphere_lights.h"
 #include "core/visibility/visibility.h"

@@ -7,7 +7,7 @@
 #include <QFileInfo>
 #include <QImageReader>
 
-#include "core/coverage/coverage_run.h"
+#include "core/run/coverage_run.h"
 #include "core/base/errors.h"
 #include "core/base/file_util.h"
 #include "core/inputs/light_file.h"

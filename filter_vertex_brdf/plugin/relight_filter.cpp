@@ -12,7 +12,7 @@
 #include "core/inputs/light_file.h"
 #include "core/inputs/light_source.h"
 #include "core/io/output_ply.h"
-#include "core/fit/pipeline.h"
+#include "core/run/fit_run.h"
 #include "core/inputs/project.h"
 #include "core/relight/relight_render.h"
 #include "core/io/result_ply.h"

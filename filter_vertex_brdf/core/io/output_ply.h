@@ -1,12 +1,12 @@
 #pragma once
 // Output PLY: the input geometry (never changed) with per-vertex results as named properties any
-// PLY reader sees, written atomically (io/output_file.h: temporary file in the same folder, checked
+// PLY reader sees, written atomically (base/output_file.h: temporary file in the same folder, checked
 // complete, then renamed), so a partial file is never left under the final name.
 #include <string>
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "io/output_file.h"
+#include "base/output_file.h"
 
 namespace vbrdf {
 

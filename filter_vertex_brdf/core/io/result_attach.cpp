@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "base/errors.h"
-#include "io/fit_outputs.h"
+#include "run/fit_outputs.h"
 #include "io/result_schema.h"
 
 namespace vbrdf {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "io/result_ply.h"
 
 namespace vbrdf {

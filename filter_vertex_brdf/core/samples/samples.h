@@ -98,7 +98,7 @@ struct GatherSettings {
   // held-out photos are compared as sampled, contamination included).
   bool own_surface_texels = true;
   // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
-  // (pipeline.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
+  // (run/fit_run.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
   LobeForm lobe = LobeForm::PhongRE;
   // The diffuse term's form stored in Sample::d (diffuse_form.h), per vertex where it varies
   // (gather_samples; make_sample takes `uniform`). kGrazing stays N.L < T_d on the plain cosine.

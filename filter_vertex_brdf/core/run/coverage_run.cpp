@@ -1,4 +1,4 @@
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 
 #include <algorithm>
 #include <chrono>
@@ -17,7 +17,7 @@
 #include "base/file_util.h"
 #include "inputs/light_file.h"
 #include "inputs/photo_prefetch.h"
-#include "io/coverage_outputs.h"
+#include "run/coverage_outputs.h"
 #include "base/vec3.h"
 #include "coverage/coverage_geometry.h"
 

@@ -3,7 +3,7 @@
 // (result_schema.h) and the human-readable report. Pure functions of the run's result.
 #include <string>
 
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 
 namespace vbrdf {
 

@@ -1,4 +1,4 @@
-#include "io/fit_outputs.h"
+#include "run/fit_outputs.h"
 
 #include <algorithm>
 #include <cmath>

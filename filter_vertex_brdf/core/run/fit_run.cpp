@@ -1,4 +1,4 @@
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 
 #include <algorithm>
 #include <chrono>
@@ -21,7 +21,7 @@
 #include "inputs/photo_prefetch.h"
 #include "fit/diffuse_choice.h"
 #include "samples/footprint.h"
-#include "io/fit_outputs.h"
+#include "run/fit_outputs.h"
 #include "io/registered_project.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"

@@ -20,7 +20,7 @@
 #include "fit/photo_shadows.h"
 #include "fit/shading_normals.h"
 #include "base/mesh_view.h"
-#include "io/output_file.h"
+#include "base/output_file.h"
 #include "io/output_ply.h"
 #include "samples/samples.h"
 #include "inputs/viewpoints.h"
@@ -73,7 +73,7 @@ struct FitSettings {
   float light_unit_scale = 0;  // mesh units per unit of the light file's positions (0: .json 1, .dome required)
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
   // An existing output PLY / report: replaced (and the log says so) or the run refused before any
-  // work (io/output_file.h). Replace by default: re-running a script into the same file is the
+  // work (base/output_file.h). Replace by default: re-running a script into the same file is the
   // normal loop, and the inputs themselves can never be outputs.
   OverwritePolicy overwrite = OverwritePolicy::Replace;
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
@@ -180,7 +180,7 @@ struct FitResult {
 
 // Runs the pipeline and writes the PLY and the report (<ply stem>_report.txt). Nothing is
 // written if any stage fails; the two files are committed together under a lock on their folder
-// (io/output_file.h), so concurrent runs leave one run's complete pair. `fitter` may be null when settings.fit_reflectance is false.
+// (base/output_file.h), so concurrent runs leave one run's complete pair. `fitter` may be null when settings.fit_reflectance is false.
 // Throws InputError / ProcessingError.
 FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
                   PhongFitter *fitter, const ProgressFn &progress, const LogFn &log);
