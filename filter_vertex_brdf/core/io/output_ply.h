@@ -26,9 +26,4 @@ void write_result_ply(const std::string &path, const MeshView &mesh, const std::
 void stage_result_ply(AtomicOutput &out, const MeshView &mesh, const std::vector<uint8_t> &colors_rgba,
                       const std::vector<VertexAttribute> &attributes);
 
-// Writes a text file atomically (used for reports), replacing an existing one.
-void write_text_file_atomically(const std::string &path, const std::string &text);
-// The same, into out.temporary() only (ProcessingError naming the cause on failure).
-void stage_text_file(AtomicOutput &out, const std::string &text);
-
 } // namespace vbrdf

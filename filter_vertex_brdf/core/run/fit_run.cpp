@@ -26,6 +26,7 @@
 #include "io/output_ply.h"
 #include "samples/light_check.h"
 #include "samples/reshade.h"
+#include "samples/sample_colors.h"
 #include "visibility/pass_size.h"
 
 namespace vbrdf {
