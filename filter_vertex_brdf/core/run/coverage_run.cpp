@@ -1,167 +1,17 @@
 #include "run/coverage_run.h"
 
 #include <algorithm>
-#include <chrono>
-#include <climits>
-#include <cmath>
-#include <cstdlib>
-#include <dirent.h>
-#include <fstream>
-#include <set>
 #include <sstream>
-#include <sys/stat.h>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "base/errors.h"
 #include "base/file_util.h"
+#include "base/vec3.h"
+#include "inputs/input_check.h"
 #include "inputs/light_file.h"
 #include "inputs/photo_prefetch.h"
 #include "run/coverage_outputs.h"
-#include "base/vec3.h"
-#include "coverage/coverage_geometry.h"
 
 namespace vbrdf {
-
-using coverage_geometry::covers_unit;
-using coverage_geometry::eye_direction;
-using coverage_geometry::unit_normal;
-
-namespace {
-
-
-
-
-
-// Whether some placeable light gives vertex (n, e) a sample of `kind` from `viewpoint`: the cheap
-// sufficient cases first (the normal, the mirror direction), else Algorithm 1/3's search.
-bool coverable(CoverageKind kind, const float *n, const float *e, const Shot &viewpoint, const float cam_z[3],
-               const LightSuggestionSettings &s) {
-  const float zmin = std::sin(s.min_elevation_deg * kPi / 180);
-  // Largest cosine between `v` and a placeable direction (the cap z >= zmin around cam_z).
-  const auto best_cos = [&](const float *v) {
-    const float theta = std::acos(std::max(-1.0f, std::min(1.0f, dot3(v, cam_z)))), edge = std::acos(zmin);
-    return theta <= edge ? 1.0f : std::cos(theta - edge);
-  };
-  const float ne = dot3(n, e);
-  if (ne <= 0) return false;
-  if (kind == CoverageKind::Diffuse) {
-    if (dot3(n, cam_z) >= zmin && covers_unit(kind, n, e, n, s)) return true;
-    if (best_cos(n) < s.diffuse_threshold) return false;  // N.L >= T_d is out of reach
-  } else {
-    const float mirror[3] = {2 * ne * n[0] - e[0], 2 * ne * n[1] - e[1], 2 * ne * n[2] - e[2]};
-    if (dot3(mirror, cam_z) >= zmin) return true;
-    if (best_cos(mirror) <= s.specular_threshold) return false;  // R.E = L.mirror > T_s is out of reach
-  }
-  float l[3];
-  return kind == CoverageKind::Diffuse ? ideal_diffuse_light(n, e, viewpoint, s, l)
-                                       : ideal_specular_light(n, e, viewpoint, s, l);
-}
-
-void camera_axis_z(const Shot &shot, float out[3]) {
-  const float towards_viewer[3] = {0, 0, 1};
-  camera_to_world_direction(shot, towards_viewer, out);
-}
-
-void report_progress(const ProgressFn &progress, float fraction, const char *stage) {
-  if (progress && !progress(fraction, stage)) throw ProcessingError("cancelled by the user");
-}
-
-// seen with some own-surface footprint texel (samples.h: kRimFootprint) in the viewpoint's first raster:
-// where its photos can give samples.
-std::vector<uint8_t> viewpoint_visible(const VisibilityMasks &masks, const Viewpoint &vp) {
-  std::vector<uint8_t> visible(masks.vertex_count, 0);
-  const size_t r = vp.rasters.front();
-  for (size_t v = 0; v < masks.vertex_count; ++v) visible[v] = masks.is_seen(r, v) && masks.own_texels(r, v) != 0;
-  return visible;
-}
-
-// Octahedral cell of a unit vector on a res x res grid.
-int octa_cell(const float n[3], int res) {
-  const float a = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
-  if (!(a > 0)) return 0;
-  float u = n[0] / a, v = n[1] / a;
-  if (n[2] < 0) {
-    const float nu = (1 - std::fabs(v)) * (u >= 0 ? 1 : -1), nv = (1 - std::fabs(u)) * (v >= 0 ? 1 : -1);
-    u = nu, v = nv;
-  }
-  const int i = std::min(res - 1, std::max(0, int((u * 0.5f + 0.5f) * float(res))));
-  const int j = std::min(res - 1, std::max(0, int((v * 0.5f + 0.5f) * float(res))));
-  return j * res + i;
-}
-
-// A direction from the object that faces (N.D >= 0.5) the most new-view vertices: a hint where
-// to put the next camera (occlusion is not considered). Normals are binned first, so the cost is
-// O(vertices) + O(cells x candidates).
-bool new_view_hint(const MeshView &mesh, const std::vector<uint32_t> &vertices, float out[3], size_t &facing) {
-  constexpr int kRes = 32, kCandidates = 400;
-  std::vector<std::array<double, 4>> cells(size_t(kRes) * kRes, std::array<double, 4>{{0, 0, 0, 0}});
-  for (uint32_t v : vertices) {
-    const float *n = mesh.normals + 3 * size_t(v);
-    auto &c = cells[size_t(octa_cell(n, kRes))];
-    c[0] += n[0], c[1] += n[1], c[2] += n[2], c[3] += 1;
-  }
-  std::vector<std::array<float, 4>> groups;  // mean normal, count
-  for (const auto &c : cells)
-    if (c[3] > 0) {
-      const double l = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-      if (l > 0) groups.push_back({{float(c[0] / l), float(c[1] / l), float(c[2] / l), float(c[3])}});
-    }
-  double best = 0;
-  for (int i = 0; i < kCandidates; ++i) {  // Fibonacci sphere
-    const float z = 1 - (2 * float(i) + 1) / float(kCandidates), r = std::sqrt(std::max(0.0f, 1 - z * z));
-    const float phi = float(i) * kPi * (3 - std::sqrt(5.0f));
-    const float d[3] = {r * std::cos(phi), r * std::sin(phi), z};
-    double score = 0;
-    for (const auto &g : groups)
-      if (dot3(g.data(), d) >= 0.5f) score += g[3];
-    if (score > best) best = score, out[0] = d[0], out[1] = d[1], out[2] = d[2];
-  }
-  facing = size_t(best + 0.5);
-  return best > 0;
-}
-
-
-
-
-
-
-
-} // namespace
-
-std::vector<uint8_t> new_view_reasons(const MeshView &mesh, const std::vector<uint8_t> &classes,
-                                      const std::vector<std::vector<uint8_t>> &visible,
-                                      const std::vector<Viewpoint> &viewpoints, const LightSuggestionSettings &s) {
-  const size_t n = mesh.vertex_count;
-  std::vector<uint8_t> reasons(n, 0);
-  std::vector<std::array<float, 3>> centres(viewpoints.size()), axes(viewpoints.size());
-  for (size_t i = 0; i < viewpoints.size(); ++i) {
-    camera_centre(viewpoints[i].shot, centres[i].data());
-    camera_axis_z(viewpoints[i].shot, axes[i].data());
-  }
-#pragma omp parallel for schedule(dynamic, 4096)
-  for (long long vi = 0; vi < (long long)n; ++vi) {
-    const size_t v = size_t(vi);
-    const uint8_t c = classes[v];
-    if (c == kUnseen) {
-      reasons[v] = kNewViewUnseen;
-      continue;
-    }
-    if (c == kFullyCovered) continue;
-    const bool diffuse = c == kSeenNotDiffuse;
-    bool ok = false;
-    for (size_t i = 0; i < viewpoints.size() && !ok; ++i) {
-      if (!visible[i][v]) continue;
-      float e[3], nrm[3];
-      eye_direction(centres[i].data(), mesh.positions + 3 * v, e);
-      unit_normal(mesh.normals + 3 * v, nrm);
-      ok = coverable(diffuse ? CoverageKind::Diffuse : CoverageKind::Specular, nrm, e, viewpoints[i].shot,
-                     axes[i].data(), s);
-    }
-    if (!ok) reasons[v] = diffuse ? kNewViewDiffuse : kNewViewSpecular;
-  }
-  return reasons;
-}
 
 std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &rasters, const std::string &lp_path,
                                                      std::vector<std::string> *unused) {
@@ -183,32 +33,42 @@ std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &
   return dirs;
 }
 
+namespace {
 
+void report_progress(const ProgressFn &progress, float fraction, const char *stage) {
+  if (progress && !progress(fraction, stage)) throw ProcessingError("cancelled by the user");
+}
 
-CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &settings_in,
-                            VisibilityBackend &visibility, const ProgressFn &progress, const LogFn &log) {
-  FitInput check;
-  check.mesh = input.mesh;
-  check.mesh_name = input.mesh_name;
-  check.rasters = input.rasters;
-  validate_input(check);
-  if (settings_in.write_files && settings_in.overwrite == OverwritePolicy::Refuse)  // before any work
-    check_output_path(settings_in.suggestion_file.empty() ? default_suggestion_path(input.project_path)
-                                                          : settings_in.suggestion_file,
-                      settings_in.overwrite, "Suggestion file");
-  const MeshView &mesh = input.mesh;
-  const size_t n = mesh.vertex_count;
+// Seen with some own-surface footprint texel (samples.h: kRimFootprint) in the viewpoint's first
+// raster: where its photos can give samples.
+std::vector<uint8_t> viewpoint_visible(const VisibilityMasks &masks, const Viewpoint &vp) {
+  std::vector<uint8_t> visible(masks.vertex_count, 0);
+  const size_t r = vp.rasters.front();
+  for (size_t v = 0; v < masks.vertex_count; ++v) visible[v] = masks.is_seen(r, v) && masks.own_texels(r, v) != 0;
+  return visible;
+}
+
+std::string suggestion_path(const CoverageInput &input, const CoverageSettings &settings) {
+  return settings.suggestion_file.empty() ? default_suggestion_path(input.project_path) : settings.suggestion_file;
+}
+
+// Everything that can be checked before any work: the mesh and rasters as the fit checks them
+// (inputs/input_check.h), a suggestion file the policy forbids replacing, and fit quality of one
+// value per vertex.
+void check_coverage_input(const CoverageInput &input, const CoverageSettings &settings) {
+  validate_mesh_and_rasters(input.mesh, input.mesh_name, input.rasters, input.vertex_mask);
+  if (settings.write_files && settings.overwrite == OverwritePolicy::Refuse)
+    check_output_path(suggestion_path(input, settings), settings.overwrite, "Suggestion file");
+  const size_t n = input.mesh.vertex_count;
   if ((!input.dq.empty() && input.dq.size() != n) || (!input.sq.empty() && input.sq.size() != n) ||
       input.dq.size() != input.sq.size())
     throw InputError("The fit quality (" + (input.quality_source.empty() ? std::string("dq/sq") : input.quality_source) +
                      ") has " + std::to_string(input.dq.size()) + " values but the mesh has " + std::to_string(n) +
                      " vertices: use the result of a fit of this mesh, or none.");
-  CoverageSettings settings = settings_in;
-  settings.suggest.specular_threshold = settings.gather.specular_threshold;
-  settings.suggest.diffuse_threshold = settings.gather.diffuse_threshold;
+}
 
-  CoverageResult r;
-  r.visibility_backend = visibility.name();
+// The rasters grouped into viewpoints, and the one the suggestions are for (settings.viewpoint_raster's).
+void choose_viewpoint(const CoverageInput &input, const CoverageSettings &settings, CoverageResult &r) {
   r.viewpoints = group_viewpoints(input.rasters);
   const int chosen = settings.viewpoint_raster;
   if (chosen < -1 || chosen >= int(input.rasters.size()))
@@ -216,101 +76,147 @@ CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &
                      std::to_string(input.rasters.size()) + " rasters (0 to " + std::to_string(input.rasters.size() - 1) +
                      "; -1 = the last one).");
   r.viewpoint = viewpoint_of_raster(r.viewpoints, chosen < 0 ? input.rasters.size() - 1 : size_t(chosen));
+}
 
-  std::vector<std::string> checked;
-  r.light_file = settings.light_file.empty() ? find_default_light_file(input.rasters, input.project_path, &checked)
-                                             : settings.light_file;
-  if (r.light_file.empty()) {
-    std::string why;
-    for (const std::string &c : checked) why += "\n  " + c;
-    throw InputError("No light file (.lp) beside the project or the photos has an entry for every raster: set "
-                     "'lightFile', or add the new photos' lights." + why);
-  }
-  // An .lp may hold entries for photos not imported yet (an acquisition in progress); light-position
-  // files (.json, .dome) and a dome radius go through the fit's resolve_lights.
+// Every raster's light. An .lp may hold entries for photos not imported yet (an acquisition in
+// progress: lights_for_rasters); light-position files (.json, .dome) and a dome radius go
+// through the fit's resolve_lights.
+std::vector<LightSource> coverage_lights(const CoverageInput &input, const CoverageSettings &settings,
+                                         CoverageResult &r, const LogFn &log) {
+  r.light_file = resolve_light_file(settings.light_file, input.rasters, input.project_path);
   std::vector<std::string> unused;
-  const LightPlacement placement =
-      light_placement_of(mesh, settings.dome_radius, settings.light_unit_scale);
+  const LightPlacement placement = light_placement_of(input.mesh, settings.dome_radius, settings.light_unit_scale);
   const bool plain_lp = placement.dome_radius <= 0 && extension_of(r.light_file) == "lp";
-  const std::vector<LightSource> sources =
-      plain_lp ? directional_lights(lights_for_rasters(input.rasters, r.light_file, &unused))
-               : resolve_lights(input.rasters, r.light_file, placement);
+  std::vector<LightSource> sources = plain_lp
+                                         ? directional_lights(lights_for_rasters(input.rasters, r.light_file, &unused))
+                                         : resolve_lights(input.rasters, r.light_file, placement);
   log("Lights: " + describe_lights(sources, placement) + " from '" + r.light_file + "'" +
       (unused.empty() ? std::string(".") : " (" + std::to_string(unused.size()) + " entries for photos not imported yet)."));
+  return sources;
+}
 
+// Every vertex's coverage counts from its samples (visibility, then the samples streamed), with
+// the photos decoded in the background during the depth passes as the fit does.
+VisibilityMasks count_coverage(const CoverageInput &input, const CoverageSettings &settings,
+                               const std::vector<LightSource> &sources, VisibilityBackend &visibility,
+                               const ProgressFn &progress, CoverageResult &r) {
+  const MeshView &mesh = input.mesh;
   PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes,
                     settings.gather.host_photos);
-  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);  // as the fit
-
+  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);
   auto t = Clock::now();
-  const VisibilityMasks masks = compute_visibility(mesh, input.rasters, sources, visibility,
-                                                   [&](float f, const char *s) { return !progress || progress(0.45f * f, s); });
+  VisibilityMasks masks = compute_visibility(mesh, input.rasters, sources, visibility,
+                                             [&](float f, const char *s) { return !progress || progress(0.45f * f, s); });
   r.seconds_visibility = seconds_since(t);
   prefetch->finish();
-
   t = Clock::now();
-  r.counts.assign(n, CoverageCounts());
+  r.counts.assign(mesh.vertex_count, CoverageCounts());
   gather_samples(mesh, input.rasters, sources, masks, settings.gather, photos,
                  [&](const SampleChunk &chunk) { count_coverage_chunk(chunk, &r.counts[chunk.first_vertex]); },
                  [&](float f, const char *s) { return !progress || progress(0.45f + 0.45f * f, s); });
   r.seconds_gather = seconds_since(t);
-  report_progress(progress, 0.9f, "suggesting lights");
+  return masks;
+}
 
-  t = Clock::now();
+bool considered(const CoverageInput &input, size_t v) { return input.vertex_mask.empty() || input.vertex_mask[v] != 0; }
+
+// Every vertex's class and colour; the class counts over the considered vertices.
+void classify_vertices(const CoverageInput &input, const CoverageSettings &settings, CoverageResult &r) {
+  const size_t n = input.mesh.vertex_count;
   r.classes.resize(n);
   r.colors_rgba.resize(4 * n);
-  const auto considered = [&input](size_t v) { return input.vertex_mask.empty() || input.vertex_mask[v] != 0; };
   for (size_t v = 0; v < n; ++v) {
     const CoverageClass c = classify_coverage(r.counts[v], settings.min_diffuse, settings.min_specular);
     r.classes[v] = c;
     const auto col = coverage_class_color(c);
     std::copy(col.begin(), col.end(), r.colors_rgba.begin() + std::ptrdiff_t(4 * v));
-    if (!considered(v)) continue;
+    if (!considered(input, v)) continue;
     ++r.vertices_considered;
     ++r.class_counts[c];
   }
-  const Viewpoint &vp = r.viewpoints[r.viewpoint];
+}
+
+// What each considered vertex still needs (coverage_needs), with the lights of the viewpoint's
+// photos that failed a vertex they were predicted to cover (prediction_failures) weighing less.
+CoverageNeeds vertex_needs(const CoverageInput &input, const CoverageSettings &settings,
+                           const std::vector<LightSource> &sources, CoverageResult &r) {
+  const size_t n = input.mesh.vertex_count;
   std::vector<uint16_t> fail_d, fail_s;
-  prediction_failures(mesh, r.classes, vp, sources, settings.suggest, fail_d, fail_s);
+  prediction_failures(input.mesh, r.classes, r.viewpoints[r.viewpoint], sources, settings.suggest, fail_d, fail_s);
   for (size_t v = 0; v < n; ++v)
-    if (!considered(v)) fail_d[v] = fail_s[v] = 0;
+    if (!considered(input, v)) fail_d[v] = fail_s[v] = 0;
   for (size_t v = 0; v < n; ++v) r.failed_diffuse += fail_d[v] > 0, r.failed_specular += fail_s[v] > 0;
   CoverageNeeds needs = coverage_needs(r.counts, input.dq.empty() ? nullptr : input.dq.data(),
                                        input.sq.empty() ? nullptr : input.sq.data(), settings, fail_d.data(),
                                        fail_s.data());
   for (size_t v = 0; v < n; ++v)
-    if (!considered(v)) {
+    if (!considered(input, v)) {
       if (v < needs.diffuse.size()) needs.diffuse[v] = 0;
       if (v < needs.specular.size()) needs.specular[v] = 0;
     }
   r.poor_diffuse = needs.poor_diffuse, r.poor_specular = needs.poor_specular;
-  std::vector<std::vector<uint8_t>> visible;
-  for (const Viewpoint &viewpoint : r.viewpoints) visible.push_back(viewpoint_visible(masks, viewpoint));
+  return needs;
+}
+
+// The next diffuse and specular light for the chosen viewpoint, learning from its photos' lights
+// and the suggestions followed before; the recommended one promises more and repeats no light
+// that failed.
+void suggest_lights(const CoverageInput &input, const CoverageSettings &settings, const std::vector<LightSource> &sources,
+                    const CoverageNeeds &needs, const std::vector<uint8_t> &visible, CoverageResult &r) {
+  const Viewpoint &vp = r.viewpoints[r.viewpoint];
   std::vector<std::array<float, 3>> taken;  // the lights of this viewpoint's photos
   for (size_t i : vp.rasters) taken.push_back(sources[i].direction);  // suggestions are directions (from the object's centre)
   if (settings.write_files && settings.learn_from_previous)
-    r.followed = followed_suggestions(settings.suggestion_file.empty() ? default_suggestion_path(input.project_path)
-                                                                       : settings.suggestion_file,
-                                      input, vp);
+    r.followed = followed_suggestions(suggestion_path(input, settings), input, vp);
   taken.insert(taken.end(), r.followed.begin(), r.followed.end());
-  r.diffuse = suggest_light_learning(mesh, vp.shot, visible[r.viewpoint].data(), needs.diffuse.data(),
-                                     CoverageKind::Diffuse, settings.suggest, settings.tolerance_deg, taken,
-                                     settings.failure_cone_deg, nullptr, &r.diffuse_repeats);
-  r.specular = suggest_light_learning(mesh, vp.shot, visible[r.viewpoint].data(), needs.specular.data(),
+  r.diffuse = suggest_light_learning(input.mesh, vp.shot, visible.data(), needs.diffuse.data(), CoverageKind::Diffuse,
+                                     settings.suggest, settings.tolerance_deg, taken, settings.failure_cone_deg,
+                                     nullptr, &r.diffuse_repeats);
+  r.specular = suggest_light_learning(input.mesh, vp.shot, visible.data(), needs.specular.data(),
                                       CoverageKind::Specular, settings.suggest, settings.tolerance_deg, taken,
                                       settings.failure_cone_deg, nullptr, &r.specular_repeats);
-  // Recommend the light that promises more, never one that failed before.
   const bool d_ok = r.diffuse.valid && !r.diffuse_repeats, s_ok = r.specular.valid && !r.specular_repeats;
   if (d_ok || s_ok) r.recommended = !s_ok || (d_ok && r.diffuse.covered_weight >= r.specular.covered_weight) ? 0 : 1;
-  const std::vector<uint8_t> reasons = new_view_reasons(mesh, r.classes, visible, r.viewpoints, settings.suggest);
-  for (size_t v = 0; v < n; ++v) {
-    if (!reasons[v] || !considered(v)) continue;
+}
+
+// The considered vertices only a new viewpoint can cover (new_view.h), how many of the seen ones
+// are seen in mixed pixels only, and a direction for that camera.
+void find_new_view_vertices(const CoverageInput &input, const CoverageSettings &settings,
+                            const std::vector<std::vector<uint8_t>> &visible, CoverageResult &r) {
+  const std::vector<uint8_t> reasons = new_view_reasons(input.mesh, r.classes, visible, r.viewpoints, settings.suggest);
+  for (size_t v = 0; v < input.mesh.vertex_count; ++v) {
+    if (!reasons[v] || !considered(input, v)) continue;
     r.new_view_vertices.push_back(uint32_t(v)), r.new_view_reasons.push_back(reasons[v]);
     bool clean = reasons[v] == kNewViewUnseen;
     for (size_t i = 0; i < visible.size() && !clean; ++i) clean = visible[i][v] != 0;
     r.new_view_mixed += !clean;
   }
-  r.has_view_hint = new_view_hint(mesh, r.new_view_vertices, r.view_hint_world, r.view_hint_vertices);
+  r.has_view_hint = new_view_hint(input.mesh, r.new_view_vertices, r.view_hint_world, r.view_hint_vertices);
+}
+
+} // namespace
+
+CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &settings_in,
+                            VisibilityBackend &visibility, const ProgressFn &progress, const LogFn &log) {
+  check_coverage_input(input, settings_in);
+  CoverageSettings settings = settings_in;
+  settings.suggest.specular_threshold = settings.gather.specular_threshold;
+  settings.suggest.diffuse_threshold = settings.gather.diffuse_threshold;
+
+  CoverageResult r;
+  r.visibility_backend = visibility.name();
+  choose_viewpoint(input, settings, r);
+  const std::vector<LightSource> sources = coverage_lights(input, settings, r, log);
+  const VisibilityMasks masks = count_coverage(input, settings, sources, visibility, progress, r);
+  report_progress(progress, 0.9f, "suggesting lights");
+
+  const auto t = Clock::now();
+  classify_vertices(input, settings, r);
+  const CoverageNeeds needs = vertex_needs(input, settings, sources, r);
+  std::vector<std::vector<uint8_t>> visible;
+  for (const Viewpoint &viewpoint : r.viewpoints) visible.push_back(viewpoint_visible(masks, viewpoint));
+  suggest_lights(input, settings, sources, needs, visible[r.viewpoint], r);
+  find_new_view_vertices(input, settings, visible, r);
   r.seconds_suggest = seconds_since(t);
 
   std::string kv_text;
