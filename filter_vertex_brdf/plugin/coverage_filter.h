@@ -3,7 +3,7 @@
 // MeshLab document: vertex colours by coverage class, selection of the vertices only a new
 // viewpoint can cover, the next diffuse and specular light in the log and in a text file beside
 // the project. The photo import filter runs it too after adding photos.
-#include "core/coverage/coverage_run.h"
+#include "core/run/coverage_run.h"
 #include "plugin_filter.h"
 
 namespace vbrdf_plugin {

@@ -26,7 +26,7 @@
 
 #include "core/calibration/color_chart.h"
 #include "core/inputs/photo.h"
-#include "core/fit/pipeline.h"
+#include "core/run/fit_run.h"
 #include "core/samples/samples.h"
 #include "core/calibration/sphere_lights.h"
 #include "core/visibility/visibility.h"
@@ -87,7 +87,7 @@ constexpr int kDefaultShadowMapSize = 0;       // automatic (vbrdf::resolved_sha
 constexpr float kCoverageDiffuseThreshold = 0.5f;  // the thesis's T_d (vbrdf::GatherSettings' default)
 
 // --- Light file (.lp) ---------------------------------------------------------------------------
-// "" = the default light-file rule (vbrdf::find_default_light_file). Returned as given: the
+// "" = the default light-file rule (vbrdf::resolve_light_file). Returned as given: the
 // filter resolves it against the project folder.
 void add_light_file(RichParameterList &params);
 std::string light_file(const RichParameterList &params);

@@ -1,7 +1,7 @@
 #pragma once
 // "Vertex BRDF: fit per-vertex reflectance": parameters and the mapping of the MeshLab document
 // onto vbrdf::run_fit.
-#include "core/fit/pipeline.h"
+#include "core/run/fit_run.h"
 #include "plugin_filter.h"
 
 namespace vbrdf_plugin {

@@ -7,7 +7,7 @@
 #include <QFileInfo>
 #include <QImageReader>
 
-#include "core/coverage/coverage_run.h"
+#include "core/run/coverage_run.h"
 #include "core/base/errors.h"
 #include "core/base/file_util.h"
 #include "core/inputs/light_file.h"
@@ -117,28 +117,12 @@ std::string lights_from_sphere(const Settings &s, const std::vector<vbrdf::Raste
   return out;
 }
 
-// .lp mode: the given .lp, or the default one (find_default_light_file: the newest one beside the
-// project or photos that has an entry for every raster, the new photos included).
-std::string lights_from_file(const Settings &s, const std::vector<vbrdf::Raster> &all,
-                             const std::vector<vbrdf::Raster> &added, const std::string &project) {
+// .lp mode: the given .lp, checked for every raster, or the default one (resolve_light_file: the
+// newest one beside the project or photos that has an entry for every raster, the new photos included).
+std::string lights_from_file(const Settings &s, const std::vector<vbrdf::Raster> &all, const std::string &project) {
   const std::string given = resolve_path(s.light_file, project);
-  if (!given.empty()) {
-    vbrdf::lights_for_rasters(all, given);  // names the first raster without entry
-    return given;
-  }
-  std::vector<std::string> checked;
-  const std::string found = vbrdf::find_default_light_file(all, project, &checked);
-  if (found.empty()) {
-    std::string why;
-    for (const std::string &c : checked) why += "\n  " + c;
-    std::string names;
-    for (const vbrdf::Raster &r : added) names += (names.empty() ? "" : ", ") + r.label;
-    throw vbrdf::InputError("No light file (.lp) beside the project or the photos has an entry for every raster "
-                            "including the new photos (" + names + "): add their lights to the .lp (e.g. with \"Vertex BRDF: "
-                            "estimate light directions from a reflective sphere\"), set 'lightFile', or choose "
-                            "'Reflective sphere'." + why);
-  }
-  return found;
+  if (!given.empty()) vbrdf::lights_for_rasters(all, given);  // names the first raster without entry
+  return vbrdf::resolve_light_file(given, all, project);
 }
 
 } // namespace
@@ -245,7 +229,7 @@ void ImportPhotosFilter::apply(FilterRun &run) const {
   std::string light_file;
   if (!added.empty())
     light_file = s.lights_from_sphere ? lights_from_sphere(s, rasters, added, reference_index, project, log)
-                                      : lights_from_file(s, all, added, project);
+                                      : lights_from_file(s, all, project);
   for (const vbrdf::Raster &r : added) add_raster(run.document, r.image_path, r.shot, r.label);
   log("Vertex BRDF import: " + std::to_string(added.size()) + " new photo(s) added with the camera of raster '" +
       reference.label + "'" + (light_file.empty() ? std::string(" (no new photo found)") : "; lights: " + light_file) +

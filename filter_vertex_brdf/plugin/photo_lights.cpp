@@ -12,10 +12,7 @@ PhotoLights photo_lights(const MeshDocument &document, const MeshModel &mesh, co
   if (active.rasters.empty())
     throw vbrdf::InputError("No photo lights to show: the project has no visible raster.");
   PhotoLights out;
-  out.file = vbrdf::find_default_light_file(active.rasters, project_path(document, mesh));
-  if (out.file.empty())
-    throw vbrdf::InputError("No photo lights to show: no light file (.lp, .json) beside the project or its photos "
-                            "lists every visible raster.");
+  out.file = vbrdf::resolve_light_file("", active.rasters, project_path(document, mesh));
   const vbrdf::LightPlacement placement = vbrdf::light_placement_of(arrays.data.view(), 0.0f, 0.0f);
   out.directions = vbrdf::light_directions(vbrdf::resolve_lights(active.rasters, out.file, placement));
   return out;

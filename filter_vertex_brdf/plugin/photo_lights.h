@@ -1,7 +1,7 @@
 #pragma once
 // The photo light directions of the open project, for the live view's light sphere
 // ("Vertex BRDF: relight", render_plugin/): the default light file of the visible rasters (the
-// fit's rule, light_file.h find_default_light_file) resolved to world directions (light_source.h;
+// fit's rule and message, light_file.h resolve_light_file) resolved to world directions (light_source.h;
 // point lights as seen from the mesh's bounding-box centre).
 #include <array>
 #include <string>

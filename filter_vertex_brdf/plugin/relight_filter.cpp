@@ -12,7 +12,7 @@
 #include "core/inputs/light_file.h"
 #include "core/inputs/light_source.h"
 #include "core/io/output_ply.h"
-#include "core/fit/pipeline.h"
+#include "core/run/fit_run.h"
 #include "core/inputs/project.h"
 #include "core/relight/relight_render.h"
 #include "core/io/result_ply.h"
@@ -119,7 +119,7 @@ std::vector<vbrdf::VertexFit> fits_from_file(const std::string &path, const Mesh
 
 struct RasterSet {
   std::vector<vbrdf::Raster> rasters;
-  std::string project, light_file;
+  std::string project;
 };
 
 RasterSet rasters_to_render(const MeshDocument &document, const MeshModel &mesh, const Settings &s) {
@@ -134,8 +134,6 @@ RasterSet rasters_to_render(const MeshDocument &document, const MeshModel &mesh,
   if (set.rasters.empty())
     throw vbrdf::InputError("No raster to render: open the project with its photos, or set 'rasterProject' to an "
                             ".mlp (e.g. the held-out photos' heldout/project.mlp).");
-  set.light_file = s.light_file.empty() ? vbrdf::find_default_light_file(set.rasters, set.project)
-                                        : resolve_path(s.light_file, project_path(document, mesh));
   return set;
 }
 
@@ -272,12 +270,10 @@ void RelightFilter::apply(FilterRun &run) const {
   s.output.folder = s.output_folder;
   std::vector<vbrdf::LightSource> lights;
   if (s.render_rasters) {
-    if (set.light_file.empty())
-      throw vbrdf::InputError("No light file (.lp) beside '" + set.project +
-                              "' or its photos has an entry for every rendered raster: set 'lightFile' to the .lp "
-                              "of the rendered rasters.");
+    const std::string light_file =
+        vbrdf::resolve_light_file(resolve_path(s.light_file, project), set.rasters, set.project);
     const vbrdf::MeshView view = arrays.data.view();
-    lights = vbrdf::resolve_lights(set.rasters, set.light_file,
+    lights = vbrdf::resolve_lights(set.rasters, light_file,
                                    vbrdf::light_placement_of(view, s.dome_radius, s.light_unit_scale));
   }
 

@@ -16,7 +16,7 @@
 #include "core/inputs/light_file.h"
 #include "core/inputs/light_source.h"
 #include "core/inputs/photo.h"
-#include "core/fit/pipeline.h"
+#include "core/run/fit_run.h"
 #include "core/calibration/sphere_lights.h"
 #include "filter_parameters.h"
 #include "meshlab_bridge.h"

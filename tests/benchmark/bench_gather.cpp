@@ -24,7 +24,7 @@
 #include "inputs/light_file.h"
 #include "tools/mesh_io.h"
 #include "osmesa_context.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "inputs/project.h"
 #include "visibility/visibility_gl.h"
 

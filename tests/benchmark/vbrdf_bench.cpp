@@ -48,7 +48,7 @@
 #include "osmesa_context.h"
 #include "io/output_ply.h"
 #include "inputs/photo.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "inputs/project.h"
 #include "tools/relight.h"
 #include "relight/orbit_camera.h"

@@ -52,7 +52,7 @@
 #include "base/file_util.h"
 #include "inputs/light_file.h"
 #include "osmesa_context.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "inputs/project.h"
 #include "tools/relight.h"
 #include "relight/relight_render.h"

@@ -23,7 +23,7 @@
 #include "base/file_util.h"
 #include "tools/mesh_io.h"
 #include "osmesa_context.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "inputs/project.h"
 
 using namespace vbrdf;

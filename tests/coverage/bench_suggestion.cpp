@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 #include "test_scenes.h"
 
 using namespace vbrdf;

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "tool_errors.h"
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 #include "base/errors.h"
 #include "tools/mesh_io.h"
 #include "osmesa_context.h"

@@ -23,7 +23,7 @@
 
 #include "tool_errors.h"
 #include "tools/acquisition_sim.h"
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 #include "base/errors.h"
 #include "tools/mesh_io.h"
 #include "osmesa_context.h"

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "tools/acquisition_sim.h"
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 #include "base/errors.h"
 #include "tools/mesh_io.h"
 #include "inputs/project.h"

@@ -15,6 +15,7 @@
 
 #include "calib_data.h"
 #include "calibration/color_chart.h"
+#include "samples/sample_colors.h"
 #include "base/color_difference.h"
 #include "base/errors.h"
 #include "inputs/photo.h"

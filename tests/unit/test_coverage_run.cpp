@@ -9,12 +9,12 @@
 #include <unistd.h>
 
 #include "tool_errors.h"
-#include "coverage/coverage_run.h"
-#include "io/coverage_outputs.h"
+#include "run/coverage_run.h"
+#include "run/coverage_outputs.h"
 #include "base/errors.h"
 #include "inputs/light_file.h"
 #include "tools/mesh_io.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"

@@ -7,7 +7,7 @@
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "inputs/light_file.h"
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 #include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"

@@ -1,5 +1,5 @@
 // Output PLY: header with named per-vertex properties, values, atomic write, NaN refusal; output
-// files that survive faults (io/output_file.h).
+// files that survive faults (base/output_file.h).
 #include <cmath>
 #include <csignal>
 #include <functional>
@@ -13,7 +13,7 @@
 
 #include "base/errors.h"
 #include "base/file_util.h"
-#include "io/output_file.h"
+#include "base/output_file.h"
 #include "io/output_ply.h"
 #include "test_paths.h"
 #include "test_scenes.h"

@@ -791,10 +791,6 @@ void apply_color_calibration(const ColorCalibration &cal, size_t photo, float rg
   cal.correction.apply(in, rgb);
 }
 
-void apply_color_calibration(const ColorCalibration &cal, Sample *samples, size_t count) {
-  for (size_t i = 0; i < count; ++i) apply_color_calibration(cal, samples[i].raster, samples[i].rgb);
-}
-
 cv::Mat apply_color_calibration(const ColorCalibration &cal, size_t photo, const cv::Mat &linear_rgb) {
   CV_Assert(linear_rgb.type() == CV_32FC3);
   cv::Mat out = linear_rgb.clone();

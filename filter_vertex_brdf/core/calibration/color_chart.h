@@ -22,7 +22,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "samples/samples.h"
+#include <cstddef>
 
 namespace vbrdf {
 
@@ -164,8 +164,6 @@ ColorCalibration calibrate_colors(size_t photo_count, const RgbLoader &load, con
 
 // Corrects one linear RGB triple of photo `photo` in place (no-op when !corrected).
 void apply_color_calibration(const ColorCalibration &cal, size_t photo, float rgb[3]);
-// Corrects samples in place; Sample::raster is the photo index given to calibrate_colors().
-void apply_color_calibration(const ColorCalibration &cal, Sample *samples, size_t count);
 // Corrected copy of a linear RGB float photo.
 cv::Mat apply_color_calibration(const ColorCalibration &cal, size_t photo, const cv::Mat &linear_rgb);
 

@@ -89,15 +89,4 @@ ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
   return plan;
 }
 
-void correct_samples(const ColorPlan &plan, SampleChunk &chunk) {
-#pragma omp parallel for schedule(static)
-  for (long long i = 0; i < (long long)chunk.samples.size(); ++i) {
-    Sample &s = chunk.samples[size_t(i)];
-    const ColorCalibration *cal = plan.of_raster(s.raster);
-    if (!cal) continue;
-    apply_color_calibration(*cal, plan.photo_of[s.raster], s.rgb);
-    for (float &c : s.rgb) c = c > 0 ? c : 0.0f;  // also NaN -> 0
-  }
-}
-
 } // namespace vbrdf

@@ -1,7 +1,7 @@
 #pragma once
 // Colour-correction planning, one for the fit and the relight comparison: every viewpoint's photos
 // are calibrated from the ColorChecker in them (color_chart.h) and each raster finds its
-// viewpoint's correction here. The fit corrects its samples with it (correct_samples), the relight
+// viewpoint's correction here. The fit corrects its samples with it (samples/sample_colors.h), the relight
 // filter its photos (apply_color_calibration), so both compare the same corrected colours.
 #include <array>
 #include <functional>
@@ -13,7 +13,6 @@
 #include "base/callbacks.h"
 #include "inputs/camera.h"
 #include "calibration/color_chart.h"
-#include "samples/samples.h"
 
 namespace vbrdf {
 
@@ -48,9 +47,5 @@ ColorPlan plan_color_correction(const std::vector<Raster> &rasters,
                                 const ColorCorrectionSettings &settings, const std::function<cv::Mat(size_t)> &load,
                                 const LogFn &log, const std::function<cv::Mat(size_t)> &detector_image = {},
                                 const RgbRegionLoader &load_region = {});
-
-// In place: corrected = M(rgb / exposure) for every sample of a corrected viewpoint. Negative
-// results (a matrix applied to noise in dark pixels) are no light, and NaN is none: both become 0.
-void correct_samples(const ColorPlan &plan, SampleChunk &chunk);
 
 } // namespace vbrdf

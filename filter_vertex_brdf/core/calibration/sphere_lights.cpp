@@ -1097,9 +1097,12 @@ bool closest_point_to_rays(const std::vector<std::array<double, 3>> &origins,
   return true;
 }
 
-LightCalibration calibrate_lights(size_t count, const GrayLoader &load, const SphereCamera &cam,
-                                  const LightSettings &settings, const std::vector<std::string> &names) {
-  LightCalibration cal;
+namespace {
+
+// The spheres: given by the user (settings.manual_spheres) or detected in the photos; InputError
+// when a given circle is unusable or no sphere is found.
+void locate_spheres(size_t count, const GrayLoader &load, const SphereCamera &cam, const LightSettings &settings,
+                    LightCalibration &cal) {
   if (!settings.manual_spheres.empty()) {
     for (size_t k = 0; k < settings.manual_spheres.size(); ++k) {
       const SphereCircle &c = settings.manual_spheres[k];
@@ -1127,7 +1130,10 @@ LightCalibration calibrate_lights(size_t count, const GrayLoader &load, const Sp
     cal.log.push_back("Sphere " + std::to_string(k + 1) + ": " + cal.spheres[k].description + " (" +
                       sphere_method_name(cal.spheres[k].method) + ", " +
                       (cam.perspective ? "perspective camera of the shot" : "orthographic view") + ").");
+}
 
+// Every photo's highlight on every sphere.
+void find_highlights(size_t count, const GrayLoader &load, const LightSettings &settings, LightCalibration &cal) {
   const size_t ns = cal.spheres.size();
   cal.photos.resize(count);
   for (size_t i = 0; i < count; ++i) {
@@ -1143,9 +1149,12 @@ LightCalibration calibrate_lights(size_t count, const GrayLoader &load, const Sp
       sl.highlight = find_highlight(g, cal.spheres[k].model.circle, settings.highlight);
     }
   }
-  // A highlight far weaker than the same sphere's in the other photos is a reflection of the
-  // surroundings, not of the light (sphere in shadow).
-  for (size_t k = 0; k < ns; ++k) {
+}
+
+// A highlight far weaker than the same sphere's in the other photos is a reflection of the
+// surroundings, not of the light (sphere in shadow): not found.
+void reject_shadowed_highlights(LightCalibration &cal) {
+  for (size_t k = 0; k < cal.spheres.size(); ++k) {
     std::vector<double> peaks;
     for (const auto &pl : cal.photos)
       if (pl.spheres[k].highlight.found) peaks.push_back(pl.spheres[k].highlight.peak);
@@ -1162,66 +1171,87 @@ LightCalibration calibrate_lights(size_t count, const GrayLoader &load, const Sp
       }
     }
   }
+}
 
+// Photo i's light from its spheres' highlights: the mean direction, the spheres' disagreement and,
+// where they disagree beyond noise, the triangulated position; a warning naming what failed.
+void light_of_photo(size_t i, const SphereCamera &cam, const LightSettings &settings,
+                    const std::vector<std::string> &names, LightCalibration &cal) {
   const double radius_world = settings.sphere_radius_world > 0 ? settings.sphere_radius_world : 1.0;
+  PhotoLight &pl = cal.photos[i];
+  std::vector<std::array<double, 3>> origins, dirs;
+  double sum[3] = {0, 0, 0};
+  std::string problems;
+  for (size_t k = 0; k < cal.spheres.size(); ++k) {
+    SphereLight &sl = pl.spheres[k];
+    const SphereModel &m = cal.spheres[k].model;
+    double point[3];
+    if (sl.highlight.found && !highlight_to_light(cam, m, sl.highlight.x, sl.highlight.y, sl.dir, nullptr, point)) {
+      sl.highlight.found = false;
+      sl.highlight.problem = "the highlight is outside the sphere's outline";
+    }
+    if (!sl.highlight.found) {
+      problems += (problems.empty() ? "" : "; ") + std::string("sphere ") + std::to_string(k + 1) + ": " +
+                  sl.highlight.problem;
+      continue;
+    }
+    sl.valid = true;
+    for (int c = 0; c < 3; ++c) sum[c] += sl.dir[c];
+    // Surface point in common units: perspective spheres sit at distance R / sin(half_angle).
+    const double s = cam.perspective ? radius_world / std::sin(m.half_angle) : 1.0;
+    origins.push_back({point[0] * s, point[1] * s, point[2] * s});
+    dirs.push_back({sl.dir[0], sl.dir[1], sl.dir[2]});
+  }
+  if (!origins.empty()) {
+    pl.valid = true;
+    normalize3(sum);
+    for (int c = 0; c < 3; ++c) pl.dir[c] = sum[c];
+    for (size_t a = 0; a < dirs.size(); ++a)
+      for (size_t b = a + 1; b < dirs.size(); ++b)
+        pl.disagreement_deg = std::max(pl.disagreement_deg, angle_deg(dirs[a].data(), dirs[b].data()));
+    // Spheres that agree within noise see a distant light: its position would be noise.
+    pl.has_position = pl.disagreement_deg >= settings.min_triangulation_deg &&
+                      closest_point_to_rays(origins, dirs, pl.position, &pl.position_rms);
+  }
+  if (!problems.empty()) {
+    pl.warning = photo_name(names, i) + (pl.valid ? ": " : " gets no light: ") + problems;
+    cal.log.push_back("Warning: " + pl.warning);
+  }
+}
+
+// The log's summary: photos with a light, the spheres' disagreement, the positions triangulated.
+void summarise_lights(size_t count, const SphereCamera &cam, const LightSettings &settings, LightCalibration &cal) {
   std::vector<double> disagreements;
   size_t positions = 0;
-  for (size_t i = 0; i < count; ++i) {
-    PhotoLight &pl = cal.photos[i];
-    std::vector<std::array<double, 3>> origins, dirs;
-    double sum[3] = {0, 0, 0};
-    std::string problems;
-    for (size_t k = 0; k < ns; ++k) {
-      SphereLight &sl = pl.spheres[k];
-      const SphereModel &m = cal.spheres[k].model;
-      double point[3];
-      if (sl.highlight.found && !highlight_to_light(cam, m, sl.highlight.x, sl.highlight.y, sl.dir, nullptr, point)) {
-        sl.highlight.found = false;
-        sl.highlight.problem = "the highlight is outside the sphere's outline";
-      }
-      if (!sl.highlight.found) {
-        problems += (problems.empty() ? "" : "; ") + std::string("sphere ") + std::to_string(k + 1) + ": " +
-                    sl.highlight.problem;
-        continue;
-      }
-      sl.valid = true;
-      for (int c = 0; c < 3; ++c) sum[c] += sl.dir[c];
-      // Surface point in common units: perspective spheres sit at distance R / sin(half_angle).
-      const double s = cam.perspective ? radius_world / std::sin(m.half_angle) : 1.0;
-      origins.push_back({point[0] * s, point[1] * s, point[2] * s});
-      dirs.push_back({sl.dir[0], sl.dir[1], sl.dir[2]});
-    }
-    if (!origins.empty()) {
-      pl.valid = true;
-      normalize3(sum);
-      for (int c = 0; c < 3; ++c) pl.dir[c] = sum[c];
-      for (size_t a = 0; a < dirs.size(); ++a)
-        for (size_t b = a + 1; b < dirs.size(); ++b)
-          pl.disagreement_deg = std::max(pl.disagreement_deg, angle_deg(dirs[a].data(), dirs[b].data()));
-      if (dirs.size() >= 2) disagreements.push_back(pl.disagreement_deg);
-      // Spheres that agree within noise see a distant light: its position would be noise.
-      pl.has_position = pl.disagreement_deg >= settings.min_triangulation_deg &&
-                        closest_point_to_rays(origins, dirs, pl.position, &pl.position_rms);
-      positions += pl.has_position ? 1 : 0;
-    }
-    if (!problems.empty()) {
-      pl.warning = photo_name(names, i) + (pl.valid ? ": " : " gets no light: ") + problems;
-      cal.log.push_back("Warning: " + pl.warning);
-    }
+  for (const PhotoLight &pl : cal.photos) {
+    if (pl.valid && std::count_if(pl.spheres.begin(), pl.spheres.end(), [](const SphereLight &s) { return s.valid; }) >= 2)
+      disagreements.push_back(pl.disagreement_deg);
+    positions += pl.has_position ? 1 : 0;
   }
   cal.log.push_back(std::to_string(cal.valid_count()) + " of " + std::to_string(count) +
                     " photos got a light direction.");
   if (!disagreements.empty()) {
-    std::vector<double> d = disagreements;
-    std::sort(d.begin(), d.end());
+    std::sort(disagreements.begin(), disagreements.end());
     cal.log.push_back(fmt("Angular disagreement between the spheres: median %.2f deg, max %.2f deg over %.0f photos.",
-                          d[d.size() / 2], d.back(), double(d.size())));
+                          disagreements[disagreements.size() / 2], disagreements.back(), double(disagreements.size())));
   }
   if (positions > 0)
     cal.log.push_back(fmt("Near-light positions triangulated for %.0f photos (camera frame, ", double(positions)) +
                       (cam.perspective ? (settings.sphere_radius_world > 0 ? "world units" : "units of the sphere radius")
                                        : "pixels") +
                       ").");
+}
+
+} // namespace
+
+LightCalibration calibrate_lights(size_t count, const GrayLoader &load, const SphereCamera &cam,
+                                  const LightSettings &settings, const std::vector<std::string> &names) {
+  LightCalibration cal;
+  locate_spheres(count, load, cam, settings, cal);
+  find_highlights(count, load, settings, cal);
+  reject_shadowed_highlights(cal);
+  for (size_t i = 0; i < count; ++i) light_of_photo(i, cam, settings, names, cal);
+  summarise_lights(count, cam, settings, cal);
   return cal;
 }
 

@@ -8,7 +8,7 @@
 #include "base/errors.h"
 #include "base/vec3.h"
 #include "coverage/coverage_geometry.h"
-#include "coverage/coverage_run.h"  // CoverageSettings
+#include "coverage/coverage_settings.h"
 
 namespace vbrdf {
 

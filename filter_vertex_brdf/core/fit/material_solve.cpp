@@ -9,12 +9,11 @@
 namespace vbrdf {
 namespace material_stage {
 
-std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &S_fit, const std::vector<Static> &S_score,
-                                   int fit_set, int score_set, const std::vector<int32_t> &label,
-                                   const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse, int K,
-                                   const std::vector<Choice> &choices, Params *params,
-                                   const std::vector<uint8_t> *wanted) {
-  // The material's mean k_s information at its alpha: the scale of both priors.
+namespace {
+
+// Per material, its vertices' mean k_s information at the material's alpha: the scale of both priors.
+std::vector<double> mean_ks_information(const Context &c, const std::vector<Static> &S_fit, int fit_set,
+                                        const std::vector<int32_t> &label, const std::vector<LobeFit> &lobes, int K) {
   std::vector<double> alpha_of(size_t(K) + 1, 1.0);
   for (int m = 1; m <= K; ++m) alpha_of[size_t(m)] = lobes[size_t(m)].alpha;
   const std::vector<Lobe> L0 = lobe_sums(c, fit_set, label, alpha_of);
@@ -26,14 +25,32 @@ std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &
     if (info > 0) mean_info[size_t(label[v])] += info, cnt[size_t(label[v])] += 1;
   }
   for (int m = 1; m <= K; ++m) mean_info[size_t(m)] = cnt[size_t(m)] > 0 ? mean_info[size_t(m)] / cnt[size_t(m)] : 0;
-  const size_t nc = choices.size();
-  std::vector<double> priors;  // the choices' distinct k_s priors; prior_index: each choice's
-  std::vector<size_t> prior_index(nc);
-  for (size_t ch = 0; ch < nc; ++ch) {
+  return mean_info;
+}
+
+// The choices' distinct k_s priors, in order of first use; prior_index receives each choice's.
+std::vector<double> distinct_priors(const std::vector<Choice> &choices, std::vector<size_t> &prior_index) {
+  std::vector<double> priors;
+  prior_index.assign(choices.size(), 0);
+  for (size_t ch = 0; ch < choices.size(); ++ch) {
     const auto it = std::find(priors.begin(), priors.end(), double(choices[ch].prior));
     prior_index[ch] = size_t(it - priors.begin());
     if (it == priors.end()) priors.push_back(double(choices[ch].prior));
   }
+  return priors;
+}
+
+} // namespace
+
+std::vector<double> solve_vertices(const Context &c, const std::vector<Static> &S_fit, const std::vector<Static> &S_score,
+                                   int fit_set, int score_set, const std::vector<int32_t> &label,
+                                   const std::vector<LobeFit> &lobes, const std::vector<uint8_t> &diffuse, int K,
+                                   const std::vector<Choice> &choices, Params *params,
+                                   const std::vector<uint8_t> *wanted) {
+  const std::vector<double> mean_info = mean_ks_information(c, S_fit, fit_set, label, lobes, K);
+  const size_t nc = choices.size();
+  std::vector<size_t> prior_index;
+  const std::vector<double> priors = distinct_priors(choices, prior_index);
   // Only the material's own alpha (k = kAlphaCentre) is needed when no choice has a per-vertex alpha.
   const bool same_sets = fit_set == score_set;  // then the score's lobe sums are the fit's
   const bool centre_only = std::all_of(choices.begin(), choices.end(), [](const Choice &ch) { return ch.alpha_prior < 0; });

@@ -10,7 +10,7 @@
 
 #include "base/errors.h"
 #include "base/file_util.h"
-#include "io/output_ply.h"
+#include "base/output_file.h"
 
 namespace vbrdf {
 
@@ -159,6 +159,22 @@ std::string find_default_light_file(const std::vector<Raster> &rasters, const st
     if (checked) checked->push_back(candidate.second + ": " + why);
   }
   return "";
+}
+
+std::string resolve_light_file(const std::string &given, const std::vector<Raster> &rasters,
+                               const std::string &project_path) {
+  if (!given.empty()) return given;
+  std::vector<std::string> checked;
+  const std::string found = find_default_light_file(rasters, project_path, &checked);
+  if (!found.empty()) return found;
+  if (checked.empty())
+    throw InputError("No light file (.lp) found beside the project or the photos: set 'lightFile' to the .lp "
+                     "that gives each photo's light direction.");
+  std::string why;
+  for (const std::string &c : checked) why += "\n  " + c;
+  throw InputError("No light file (.lp) beside the project or the photos has an entry for every raster: set "
+                   "'lightFile' to the .lp that gives each photo's light direction, or add the missing lines." +
+                   why);
 }
 
 } // namespace vbrdf

@@ -44,4 +44,14 @@ int find_light_for_image(const std::vector<LightEntry> &lights, const std::strin
 std::string find_default_light_file(const std::vector<Raster> &rasters, const std::string &project_path,
                                     std::vector<std::string> *checked = nullptr);
 
+// The light file of a run: `given` (a path the caller resolved) when not empty, else the default
+// rule's file (find_default_light_file). Every filter and tool resolves its 'lightFile' here, so
+// that a missing file reads the same everywhere: throws InputError "No light file (.lp) found
+// beside the project or the photos: ..." when there is no candidate, or "No light file (.lp)
+// beside the project or the photos has an entry for every raster: ..." followed by each file
+// checked and why it does not serve; both name 'lightFile'. `given` is not read here: reading it
+// reports its own errors (read_light_file, light_source.h).
+std::string resolve_light_file(const std::string &given, const std::vector<Raster> &rasters,
+                               const std::string &project_path);
+
 } // namespace vbrdf

@@ -9,7 +9,7 @@
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "inputs/light_file.h"
-#include "io/output_ply.h"  // write_text_file_atomically
+#include "base/output_file.h"
 
 namespace vbrdf {
 

@@ -107,22 +107,4 @@ void write_result_ply(const std::string &path, const MeshView &mesh, const std::
   out.commit();
 }
 
-void stage_text_file(AtomicOutput &out, const std::string &text) {
-  std::FILE *f = std::fopen(out.temporary().c_str(), "wb");
-  const bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const bool closed = f && std::fclose(f) == 0;
-  if (!ok || !closed) {
-    const std::string cause = out.failure_cause();
-    std::remove(out.temporary().c_str());
-    throw ProcessingError("Cannot write '" + out.path() + "': " + cause + ". Free space or choose another folder; " +
-                          (file_exists(out.path()) ? "the previous file is unchanged." : "nothing was written."));
-  }
-}
-
-void write_text_file_atomically(const std::string &path, const std::string &text) {
-  AtomicOutput out(path);
-  stage_text_file(out, text);
-  out.commit((long long)text.size());
-}
-
 } // namespace vbrdf

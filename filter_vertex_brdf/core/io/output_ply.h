@@ -1,12 +1,12 @@
 #pragma once
 // Output PLY: the input geometry (never changed) with per-vertex results as named properties any
-// PLY reader sees, written atomically (io/output_file.h: temporary file in the same folder, checked
+// PLY reader sees, written atomically (base/output_file.h: temporary file in the same folder, checked
 // complete, then renamed), so a partial file is never left under the final name.
 #include <string>
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "io/output_file.h"
+#include "base/output_file.h"
 
 namespace vbrdf {
 
@@ -25,10 +25,5 @@ void write_result_ply(const std::string &path, const MeshView &mesh, const std::
 // ProcessingError naming the cause); out.commit() then puts it in place.
 void stage_result_ply(AtomicOutput &out, const MeshView &mesh, const std::vector<uint8_t> &colors_rgba,
                       const std::vector<VertexAttribute> &attributes);
-
-// Writes a text file atomically (used for reports), replacing an existing one.
-void write_text_file_atomically(const std::string &path, const std::string &text);
-// The same, into out.temporary() only (ProcessingError naming the cause on failure).
-void stage_text_file(AtomicOutput &out, const std::string &text);
 
 } // namespace vbrdf

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "base/errors.h"
-#include "io/fit_outputs.h"
 #include "io/result_schema.h"
+#include "io/vertex_quality.h"
 
 namespace vbrdf {
 
@@ -65,7 +65,7 @@ AttachedResult attach_result(const ResultPly &result, const MeshView &mesh, cons
     out.quality.resize(n);
     for (size_t v = 0; v < n; ++v) {
       const VertexFit &f = fits[v];
-      out.quality[v] = quality == QualityOutput::SQ ? f.sq : quality == QualityOutput::RMSE ? f.rmse : f.dq;
+      out.quality[v] = vertex_quality(f, quality);
       out.modelled += f.status != kFitNone;
     }
     neutral_quality_for_unmodelled(fits, out.quality);

@@ -9,8 +9,9 @@
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "fit/pipeline.h"
+#include "io/output_ply.h"  // VertexAttribute
 #include "io/result_ply.h"
+#include "io/vertex_quality.h"
 
 namespace vbrdf {
 

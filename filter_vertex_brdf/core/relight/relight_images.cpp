@@ -13,7 +13,7 @@
 #include "base/color_difference.h"
 #include "base/errors.h"
 #include "base/file_util.h"
-#include "io/output_ply.h"  // write_text_file_atomically
+#include "base/output_file.h"
 #include "base/vec3.h"
 
 namespace vbrdf {

@@ -19,7 +19,6 @@
 #include "gl/gl_api.h"
 #include "gl/gl_depth.h"
 #include "gl/light_view.h"
-#include "io/output_ply.h"  // write_text_file_atomically
 #include "relight/phong_model_source.h"
 #include "inputs/viewpoints.h"
 #include "base/vec3.h"

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "io/output_file.h"
+#include "base/output_file.h"
 #include "calibration/color_plan.h"
 #include "inputs/light_source.h"
 #include "inputs/photo.h"

@@ -3,7 +3,7 @@
 // Everything later stages read (colour, fit, coverage) comes from here.
 //
 // Memory: visibility is computed per photo for all vertices and kept as bit masks
-// (2 bits per vertex and photo); pixel samples are then produced per vertex chunk, so the number
+// (visibility/visibility_masks.h); pixel samples are then produced per vertex chunk, so the number
 // of photos and vertices is limited by disk and time, not by memory. A sample is 24 bytes.
 #include <array>
 #include <cmath>
@@ -19,7 +19,7 @@
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
 #include "inputs/photo.h"
-#include "visibility/visibility.h"
+#include "visibility/visibility_masks.h"
 
 namespace vbrdf {
 
@@ -98,7 +98,7 @@ struct GatherSettings {
   // held-out photos are compared as sampled, contamination included).
   bool own_surface_texels = true;
   // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
-  // (pipeline.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
+  // (run/fit_run.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
   LobeForm lobe = LobeForm::PhongRE;
   // The diffuse term's form stored in Sample::d (diffuse_form.h), per vertex where it varies
   // (gather_samples; make_sample takes `uniform`). kGrazing stays N.L < T_d on the plain cosine.
@@ -114,43 +114,6 @@ struct GatherSettings {
   // for its pilot and its gather); empty: gather_samples computes them.
   std::shared_ptr<const std::vector<float>> normal_gradients;
 };
-
-// Per-photo, per-vertex bits from the depth passes: `seen` = inside the photo, front-facing and
-// not occluded (the camera pass combined with the per-vertex frustum/facing test), `lit` = not in
-// cast shadow, tested for the vertices the photo sees only (the others read as lit). Per-photo
-// counts say why vertices were not seen.
-struct VisibilityMasks {
-  size_t vertex_count = 0;
-  size_t raster_count = 0;
-  std::vector<uint64_t> seen;  // raster-major: word (r * words() + v / 64), bit v % 64
-  std::vector<uint64_t> lit;
-  std::vector<uint64_t> mixed;  // seen, but the pixel footprint straddles a depth jump
-  // Per raster, for its mixed vertices only, sorted: (v << 4) | mask of the footprint texels on the
-  // vertex's own surface (visibility.h). Sparse: only rims and contacts are listed.
-  std::vector<std::vector<uint32_t>> footprints;
-  std::vector<uint32_t> off_image, back_facing, occluded, seen_count;  // per raster
-  size_t camera_passes = 0;  // camera passes run: one per run of rasters with the same shot
-  size_t words() const { return (vertex_count + 63) / 64; }
-  bool is_seen(size_t r, size_t v) const { return (seen[r * words() + v / 64] >> (v % 64)) & 1u; }
-  bool is_lit(size_t r, size_t v) const { return (lit[r * words() + v / 64] >> (v % 64)) & 1u; }
-  bool is_mixed(size_t r, size_t v) const { return (mixed[r * words() + v / 64] >> (v % 64)) & 1u; }
-  // Own-surface texels of the footprint of vertex v in raster r: kAllFootprintTexels unless mixed.
-  uint8_t own_texels(size_t r, size_t v) const;
-  // True when raster r sees at least one vertex in [first, first + count).
-  bool sees_any(size_t r, size_t first, size_t count) const;
-};
-
-
-// Runs the camera and light depth passes for every raster. lights[r] is the light of raster r.
-// A raster whose shot is the previous camera pass's (same_shot) reuses that pass's codes.
-VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raster> &rasters,
-                                   const std::vector<LightSource> &lights,
-                                   VisibilityBackend &backend, const ProgressFn &progress = {});
-
-// "Only on selection": clears the seen, lit and mixed bits of every vertex with vertex_mask[v] == 0,
-// so that no stage samples it (it reads as seen by no photo), and recounts seen_count. An empty
-// mask keeps every vertex. Throws InputError when the mask's size is not the vertex count.
-void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &vertex_mask);
 
 // Builds the sample of vertex (position, normal) in raster `raster_index` whose photo is `photo`,
 // lit by `light` (its direction at the vertex: light_direction_at). The colour is the photo's,

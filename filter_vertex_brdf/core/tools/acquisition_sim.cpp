@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 #include "base/errors.h"
 
 namespace vbrdf {

@@ -227,6 +227,156 @@ void check_sizes(const MeshView &mesh, const std::vector<VertexFit> &fits, const
 }
 } // namespace
 
+namespace {
+
+// What scoring a held-out sample reads: the model, the photos (held-out first, then training),
+// their visibility and the baselines' plan.
+struct Evaluation {
+  const MeshView &mesh;
+  const std::vector<VertexFit> &fits;
+  const std::vector<Raster> &rasters;     // held-out
+  const std::vector<LightSource> &lights; // held-out
+  const std::vector<std::array<float, 3>> &light_dirs_world;
+  const VisibilityMasks &masks;
+  const BaselinePlan &plan;
+  const SeenAlbedo &seen_albedo_of;
+  const RelightOptions &options;
+  size_t n_held;
+  bool baselines;
+};
+
+// The errors of every scored sample, in vertex order.
+struct ErrorLists {
+  std::vector<double> all, clean, base_product, ptm, rbf, fp_product[2], fp_rbf[2];
+  double squared_error = 0;
+};
+
+// Whether sample `s` of vertex v is a held-out sample the evaluation scores: unsaturated and lit
+// (RelightOptions::lit_filter where given).
+bool scores(const Evaluation &ev, const Sample &s, size_t v) {
+  if (s.raster >= ev.n_held) return false;  // training photo
+  if (s.flags & kSaturated) return false;
+  return ev.options.lit_filter ? (*ev.options.lit_filter)[size_t(s.raster) * ev.mesh.vertex_count + v] != 0
+                               : !((s.flags & kShadowed) || !(s.d > 0));
+}
+
+// The model's prediction of sample `s` of vertex v: under the light's irradiance at the vertex,
+// and through the rendered image's footprint where the pixel straddles a depth jump.
+void predict_sample(const Evaluation &ev, const Sample &s, size_t v, float predicted[3]) {
+  const VertexFit &fit = ev.fits[v];
+  evaluate_phong(ev.seen_albedo_of.as_seen(fit, s.raster, v), s.d, s.lobe_cos, ev.options.gather.lobe, predicted,
+                 s.footprint);
+  const float irradiance = light_irradiance_at(ev.lights[s.raster], ev.mesh.positions + 3 * v);
+  for (int c = 0; c < 3; ++c) predicted[c] *= irradiance;
+  const uint8_t own = ev.masks.own_texels(s.raster, v);
+  if (ev.options.rendered && own != kAllFootprintTexels) {
+    const ImagePoint ip = project_to_image(ev.rasters[s.raster].shot, ev.mesh.positions + 3 * v);
+    const float at_vertex[3] = {predicted[0], predicted[1], predicted[2]};
+    predict_footprint((*ev.options.rendered)[s.raster], ip.x, ip.y, own, at_vertex, predicted);
+  }
+}
+
+// The per-pixel PTM and RBF baselines' errors for sample `s`, fitted on the vertex's training
+// samples of the held-out photo's viewpoint (once per vertex and viewpoint, in `fitted`).
+void score_baselines(const Evaluation &ev, const Sample &s, const Sample *samples, size_t count,
+                     std::vector<VertexBaseline> &fitted, Scored &r) {
+  const int vp = ev.baselines ? ev.plan.viewpoint_of_heldout[s.raster] : -1;
+  if (vp < 0) return;
+  VertexBaseline &b = fitted[size_t(vp)];
+  if (!b.fitted) fit_vertex_baseline(ev.plan, vp, samples, count, ev.options.rbf_ridge, b);
+  if (b.count == 0) return;
+  float p[3];
+  evaluate_ptm(b.ptm, ev.plan.heldout_uv[s.raster][0], ev.plan.heldout_uv[s.raster][1], p);
+  clamp_below_zero(p);
+  r.sample.de_ptm = float(delta_e2000_linear_srgb(p, s.rgb));
+  evaluate_rbf(b.dirs.data(), b.weights.data(), b.count, ev.plan.viewpoints[size_t(vp)].sigma,
+               ev.light_dirs_world[s.raster].data(), p);
+  clamp_below_zero(p);
+  r.sample.de_rbf = float(delta_e2000_linear_srgb(p, s.rgb));
+  r.has_baseline = true;
+}
+
+// Every scored held-out sample of chunk vertex i, into `out`.
+void score_vertex(const Evaluation &ev, const SampleChunk &chunk, uint32_t i, std::vector<Scored> &out) {
+  const size_t v = chunk.first_vertex + i;
+  const Sample *samples = chunk.samples.data() + chunk.offsets[i];
+  const size_t count = chunk.offsets[i + 1] - chunk.offsets[i];
+  const VertexFit &fit = ev.fits[v];
+  std::vector<VertexBaseline> fitted(ev.plan.viewpoints.size());
+  for (size_t k = 0; k < count; ++k) {
+    const Sample &s = samples[k];
+    if (!scores(ev, s, v)) continue;
+    Scored r{};
+    ScoredSample &o = r.sample;
+    o.vertex = uint32_t(v);
+    o.raster = s.raster;
+    o.fit_status = fit.status;
+    o.mixed = (s.flags & kMixedPixel) != 0;
+    o.d = s.d;
+    r.modelled = has_model(fit);
+    float predicted[3];
+    predict_sample(ev, s, v, predicted);
+    for (int c = 0; c < 3; ++c) o.observed[c] = s.rgb[c], o.predicted[c] = predicted[c];
+    o.de = float(delta_e2000_linear_srgb(predicted, s.rgb));
+    o.de_ptm = o.de_rbf = -1.0f;
+    for (int c = 0; c < 3; ++c) {
+      const float e = std::min(predicted[c], 1.0f) - s.rgb[c];
+      r.squared_error += e * e;
+    }
+    score_baselines(ev, s, samples, count, fitted, r);
+    out.push_back(r);
+  }
+}
+
+// A scored sample into the error lists and the per-raster and count figures.
+void collect(const Scored &scored, bool baselines, const RelightOptions &options, ErrorLists &errors,
+             RelightStats &stats) {
+  const ScoredSample &r = scored.sample;
+  if (options.per_sample) options.per_sample->push_back(r);
+  errors.all.push_back(r.de);
+  errors.squared_error += scored.squared_error;
+  stats.per_raster_mean_de2000[r.raster] += r.de;
+  ++stats.per_raster_samples[r.raster];
+  if (!scored.modelled) ++stats.unmodelled_samples;
+  if (scored.modelled && !r.mixed) errors.clean.push_back(r.de);
+  if (!baselines) return;
+  if (!scored.has_baseline) {
+    ++stats.baseline_excluded;
+    return;
+  }
+  errors.base_product.push_back(r.de);
+  errors.ptm.push_back(r.de_ptm);
+  errors.rbf.push_back(r.de_rbf);
+  errors.fp_product[r.mixed].push_back(r.de);
+  errors.fp_rbf[r.mixed].push_back(r.de_rbf);
+}
+
+// The summaries of the error lists.
+void summarise_errors(const ErrorLists &errors, size_t n_held, RelightStats &stats) {
+  for (size_t r = 0; r < n_held; ++r)
+    if (stats.per_raster_samples[r]) stats.per_raster_mean_de2000[r] /= double(stats.per_raster_samples[r]);
+  const ErrorSummary whole = summarise(errors.all);
+  stats.samples = whole.samples;
+  stats.mean_de2000 = whole.mean;
+  stats.median_de2000 = whole.median;
+  stats.p95_de2000 = whole.p95;
+  if (!errors.all.empty()) {
+    const double mse = errors.squared_error / double(3 * errors.all.size());
+    stats.psnr_db = mse > 0 ? 10 * std::log10(1.0 / mse) : 99.0;
+    stats.unmodelled_share = double(stats.unmodelled_samples) / double(errors.all.size());
+  }
+  stats.clean_modelled = summarise(errors.clean);
+  stats.product_on_baseline_set = summarise(errors.base_product);
+  stats.ptm = summarise(errors.ptm);
+  stats.rbf = summarise(errors.rbf);
+  stats.product_clean_footprint = summarise(errors.fp_product[0]);
+  stats.rbf_clean_footprint = summarise(errors.fp_rbf[0]);
+  stats.product_mixed_footprint = summarise(errors.fp_product[1]);
+  stats.rbf_mixed_footprint = summarise(errors.fp_rbf[1]);
+}
+
+} // namespace
+
 RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexFit> &fits,
                                  const std::vector<Raster> &rasters,
                                  const std::vector<LightSource> &lights, VisibilityBackend &visibility,
@@ -258,9 +408,9 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
   const VisibilityMasks masks = compute_visibility(mesh, all, all_lights, visibility);
   PhotoCache photos(settings.encoding, settings.saturation_level, settings.photo_cache_bytes);
   const SeenAlbedo seen_albedo_of = seen_albedo(mesh, fits, all, n_held, masks, options);
+  const Evaluation ev{mesh, fits, rasters, lights, light_dirs_world, masks, plan, seen_albedo_of, options, n_held, baselines};
 
-  std::vector<double> de_all, de_clean, de_base_product, de_ptm, de_rbf, fp_product[2], fp_rbf[2];
-  double squared_error = 0;
+  ErrorLists errors;
   std::vector<std::vector<Scored>> scored;
   gather_samples(mesh, all, all_lights, masks, settings, photos, [&](const SampleChunk &chunk) {
     scored.assign(chunk.vertex_count, {});
@@ -268,114 +418,19 @@ RelightStats evaluate_relighting(const MeshView &mesh, const std::vector<VertexF
 #pragma omp parallel for schedule(dynamic, 256)
     for (long long ii = 0; ii < (long long)chunk.vertex_count; ++ii) {
       const uint32_t i = uint32_t(ii);
-      const size_t v = chunk.first_vertex + i;
-      if (options.vertex_filter && !(*options.vertex_filter)[v]) continue;
-      const Sample *samples = chunk.samples.data() + chunk.offsets[i];
-      const size_t count = chunk.offsets[i + 1] - chunk.offsets[i];
-      seen[i] = count > 0;
-      const VertexFit &fit = fits[v];
-      std::vector<VertexBaseline> fitted(plan.viewpoints.size());
-      for (size_t k = 0; k < count; ++k) {
-        const Sample &s = samples[k];
-        if (s.raster >= n_held) continue;  // training photo
-        if (s.flags & kSaturated) continue;
-        if (options.lit_filter ? !(*options.lit_filter)[size_t(s.raster) * mesh.vertex_count + v]
-                               : ((s.flags & kShadowed) || !(s.d > 0)))
-          continue;
-        Scored r{};
-        ScoredSample &o = r.sample;
-        o.vertex = uint32_t(v);
-        o.raster = s.raster;
-        o.fit_status = fit.status;
-        o.mixed = (s.flags & kMixedPixel) != 0;
-        o.d = s.d;
-        r.modelled = has_model(fit);
-        float predicted[3];
-        evaluate_phong(seen_albedo_of.as_seen(fit, s.raster, v), s.d, s.lobe_cos, options.gather.lobe, predicted,
-                       s.footprint);
-        const float irradiance = light_irradiance_at(lights[s.raster], mesh.positions + 3 * v);
-        for (float &c : predicted) c *= irradiance;
-        const uint8_t own = masks.own_texels(s.raster, v);
-        if (options.rendered && own != kAllFootprintTexels) {
-          const ImagePoint ip = project_to_image(rasters[s.raster].shot, mesh.positions + 3 * v);
-          const float at_vertex[3] = {predicted[0], predicted[1], predicted[2]};
-          predict_footprint((*options.rendered)[s.raster], ip.x, ip.y, own, at_vertex, predicted);
-        }
-        for (int c = 0; c < 3; ++c) o.observed[c] = s.rgb[c], o.predicted[c] = predicted[c];
-        o.de = float(delta_e2000_linear_srgb(predicted, s.rgb));
-        o.de_ptm = o.de_rbf = -1.0f;
-        for (int c = 0; c < 3; ++c) {
-          const float e = std::min(predicted[c], 1.0f) - s.rgb[c];
-          r.squared_error += e * e;
-        }
-        const int vp = baselines ? plan.viewpoint_of_heldout[s.raster] : -1;
-        if (vp >= 0) {
-          VertexBaseline &b = fitted[size_t(vp)];
-          if (!b.fitted) fit_vertex_baseline(plan, vp, samples, count, options.rbf_ridge, b);
-          if (b.count > 0) {
-            float p[3];
-            evaluate_ptm(b.ptm, plan.heldout_uv[s.raster][0], plan.heldout_uv[s.raster][1], p);
-            clamp_below_zero(p);
-            o.de_ptm = float(delta_e2000_linear_srgb(p, s.rgb));
-            evaluate_rbf(b.dirs.data(), b.weights.data(), b.count, plan.viewpoints[size_t(vp)].sigma,
-                         light_dirs_world[s.raster].data(), p);
-            clamp_below_zero(p);
-            o.de_rbf = float(delta_e2000_linear_srgb(p, s.rgb));
-            r.has_baseline = true;
-          }
-        }
-        scored[i].push_back(r);
-      }
+      if (options.vertex_filter && !(*options.vertex_filter)[chunk.first_vertex + i]) continue;
+      seen[i] = chunk.offsets[i + 1] > chunk.offsets[i];
+      score_vertex(ev, chunk, i, scored[i]);
     }
     for (uint32_t i = 0; i < chunk.vertex_count; ++i) {
-      const bool modelled = has_model(fits[chunk.first_vertex + i]);
       if (seen[i]) {
         ++stats.seen_vertices;
-        if (!modelled) ++stats.seen_unmodelled_vertices;
+        if (!has_model(fits[chunk.first_vertex + i])) ++stats.seen_unmodelled_vertices;
       }
-      for (const Scored &scored_sample : scored[i]) {
-        const ScoredSample &r = scored_sample.sample;
-        if (options.per_sample) options.per_sample->push_back(r);
-        de_all.push_back(r.de);
-        squared_error += scored_sample.squared_error;
-        stats.per_raster_mean_de2000[r.raster] += r.de;
-        ++stats.per_raster_samples[r.raster];
-        if (!scored_sample.modelled) ++stats.unmodelled_samples;
-        if (scored_sample.modelled && !r.mixed) de_clean.push_back(r.de);
-        if (!baselines) continue;
-        if (!scored_sample.has_baseline) {
-          ++stats.baseline_excluded;
-          continue;
-        }
-        de_base_product.push_back(r.de);
-        de_ptm.push_back(r.de_ptm);
-        de_rbf.push_back(r.de_rbf);
-        fp_product[r.mixed].push_back(r.de);
-        fp_rbf[r.mixed].push_back(r.de_rbf);
-      }
+      for (const Scored &s : scored[i]) collect(s, baselines, options, errors, stats);
     }
   });
-
-  for (size_t r = 0; r < n_held; ++r)
-    if (stats.per_raster_samples[r]) stats.per_raster_mean_de2000[r] /= double(stats.per_raster_samples[r]);
-  const ErrorSummary whole = summarise(de_all);
-  stats.samples = whole.samples;
-  stats.mean_de2000 = whole.mean;
-  stats.median_de2000 = whole.median;
-  stats.p95_de2000 = whole.p95;
-  if (!de_all.empty()) {
-    const double mse = squared_error / double(3 * de_all.size());
-    stats.psnr_db = mse > 0 ? 10 * std::log10(1.0 / mse) : 99.0;
-    stats.unmodelled_share = double(stats.unmodelled_samples) / double(de_all.size());
-  }
-  stats.clean_modelled = summarise(de_clean);
-  stats.product_on_baseline_set = summarise(de_base_product);
-  stats.ptm = summarise(de_ptm);
-  stats.rbf = summarise(de_rbf);
-  stats.product_clean_footprint = summarise(fp_product[0]);
-  stats.rbf_clean_footprint = summarise(fp_rbf[0]);
-  stats.product_mixed_footprint = summarise(fp_product[1]);
-  stats.rbf_mixed_footprint = summarise(fp_rbf[1]);
+  summarise_errors(errors, n_held, stats);
   return stats;
 }
 

@@ -1,4 +1,4 @@
-#include "fit/pipeline.h"
+#include "run/fit_run.h"
 
 #include <algorithm>
 #include <chrono>
@@ -19,14 +19,17 @@
 #include "inputs/light_file.h"
 #include "inputs/light_source.h"
 #include "inputs/photo_prefetch.h"
+#include "inputs/input_check.h"
 #include "fit/diffuse_choice.h"
 #include "samples/footprint.h"
-#include "io/fit_outputs.h"
+#include "run/fit_outputs.h"
 #include "io/registered_project.h"
 #include "io/output_ply.h"
 #include "samples/light_check.h"
 #include "samples/reshade.h"
+#include "samples/sample_colors.h"
 #include "visibility/pass_size.h"
+#include "visibility/visibility_masks.h"
 
 namespace vbrdf {
 
@@ -40,25 +43,7 @@ std::string registered_project_path(const std::string &output_ply) {
 }
 
 void validate_input(const FitInput &input) {
-  validate_mesh(input.mesh, input.mesh_name);
-  if (!input.vertex_mask.empty() && input.vertex_mask.size() != input.mesh.vertex_count)
-    throw InputError("internal: the vertex selection has " + std::to_string(input.vertex_mask.size()) +
-                     " entries for " + std::to_string(input.mesh.vertex_count) + " vertices");
-  if (input.rasters.empty())
-    throw InputError("The project has no rasters: load the registered photos (File > Import Raster) or open the .mlp.");
-  for (size_t r = 0; r < input.rasters.size(); ++r) {
-    const Raster &raster = input.rasters[r];
-    if (!shot_is_valid(raster.shot))
-      throw InputError("Raster " + std::to_string(r) + " ('" + raster.label +
-                       "') has no valid camera: register it to the mesh first.");
-    if (shot_is_identity(raster.shot))
-      throw InputError("Raster " + std::to_string(r) + " ('" + raster.label +
-                       "') has an identity camera (at the world origin, looking along -z): it was not registered. "
-                       "Register it to the mesh first, or remove the raster.");
-    if (!file_exists(raster.image_path))
-      throw InputError("Raster " + std::to_string(r) + " ('" + raster.label + "'): photo '" + raster.image_path +
-                       "' is missing. Restore the file or fix the path in the project.");
-  }
+  validate_mesh_and_rasters(input.mesh, input.mesh_name, input.rasters, input.vertex_mask);
 }
 
 namespace {
@@ -402,100 +387,116 @@ void summarise_shading_normals(const FitInput &input, const VisibilityMasks &mas
 }
 } // namespace
 
-FitResult run_fit(const FitInput &given, const FitSettings &settings_in, VisibilityBackend &visibility,
-                  PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {
-  validate_input(given);
-  FitInput input = given;  // its rasters take the corrected cameras (registration), the caller's never change
-  FitSettings settings = settings_in;
+namespace {
+
+// One fit run's working state, shared by its steps.
+struct FitRun {
+  FitInput input;        // its rasters take the corrected cameras (registration); the caller's never change
+  FitSettings settings;  // as every stage reads them (settings_for_run)
+  VisibilityBackend &visibility;
+  PhongFitter *fitter;   // null when settings.fit_reflectance is false
+  const ProgressFn &progress;
+  const LogFn &log;
+  LightPlacement placement;
+  std::vector<LightSource> lights;  // per raster
+  FitResult result;
+};
+
+// The settings as every stage reads them: one T_s and one lobe form for the samples and the fit,
+// and the mesh's normal gradients computed once for the pilot's and the fit's gathers.
+FitSettings settings_for_run(const FitSettings &given, const MeshView &mesh, const PhongFitter *fitter) {
+  FitSettings settings = given;
   settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
   settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
   if (settings.fit_reflectance && settings.gather.footprint && settings.gather.lobe == LobeForm::GgxNH)
     settings.gather.normal_gradients =  // once for the pilot's and the fit's gathers (footprint.h)
-        std::make_shared<const std::vector<float>>(normal_gradients(input.mesh));
+        std::make_shared<const std::vector<float>>(normal_gradients(mesh));
   if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
-  const MeshView &mesh = input.mesh;
-  FitResult result;
-  result.visibility_backend = visibility.name();
-  result.fit_backend = settings.fit_reflectance ? fitter->name() : "";
+  return settings;
+}
 
-  std::vector<std::string> checked;
-  result.light_file = settings.light_file.empty() ? find_default_light_file(input.rasters, input.project_path, &checked)
-                                                  : settings.light_file;
-  if (result.light_file.empty() && checked.empty())
-    throw InputError("No light file (.lp) found beside the project or the photos: set 'lightFile' to the .lp "
-                     "that gives each photo's light direction.");
-  if (result.light_file.empty()) {
-    std::string why;
-    for (const std::string &c : checked) why += "\n  " + c;
-    throw InputError("No light file (.lp) beside the project or the photos has an entry for every raster: set "
-                     "'lightFile' to the .lp that gives each photo's light direction, or add the missing lines." +
-                     why);
-  }
-  const LightPlacement placement =
-      light_placement_of(mesh, settings.dome_radius, settings.light_unit_scale);
-  std::vector<LightSource> lights = resolve_lights(input.rasters, result.light_file, placement);
-  result.light_model = describe_lights(lights, placement);
-  log("Lights: " + result.light_model + ", from '" + result.light_file + "'.");
+// The light file (resolve_light_file) and every raster's light, placed for the mesh.
+void resolve_run_lights(FitRun &run) {
+  FitResult &result = run.result;
+  result.light_file = resolve_light_file(run.settings.light_file, run.input.rasters, run.input.project_path);
+  run.placement = light_placement_of(run.input.mesh, run.settings.dome_radius, run.settings.light_unit_scale);
+  run.lights = resolve_lights(run.input.rasters, result.light_file, run.placement);
+  result.light_model = describe_lights(run.lights, run.placement);
+  run.log("Lights: " + result.light_model + ", from '" + result.light_file + "'.");
+}
 
+// Where the outputs go, checked before any work: never over an input file, and every output
+// writable under the overwrite policy (base/output_file.h).
+void check_output_paths(FitRun &run) {
+  const FitInput &input = run.input;
+  const FitSettings &settings = run.settings;
+  FitResult &result = run.result;
   result.output_ply = settings.output_ply.empty() ? default_output_path(input.project_path) : settings.output_ply;
   for (const std::string &protected_path : {input.project_path, input.mesh_path})
     if (!protected_path.empty() && result.output_ply == protected_path)
       throw InputError("The output '" + result.output_ply + "' would overwrite an input file: choose another 'outputPly'.");
-
   check_output_path(report_path_for(result.output_ply), settings.overwrite, "Output PLY");
   if (settings.registration.enabled)
     check_output_path(registered_project_path(result.output_ply), settings.overwrite, "Output PLY");
   result.output_note = check_output_path(result.output_ply, settings.overwrite, "Output PLY");
-  result.normals_source = describe_normals_source(input.mesh_path);
-  log(result.normals_source + ".");
+}
 
-  // The photos decode in the background while the GL passes run (photo_prefetch.h); a photo that
-  // cannot be decoded fails before any sample is gathered, so before anything is written.
-  PhotoCache photos(settings.gather.encoding, settings.gather.saturation_level, settings.gather.photo_cache_bytes,
-                    settings.gather.host_photos);
-  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, input.rasters);
-  if (settings.registration.enabled) {
-    if (progress && !progress(0.0f, "registration")) throw ProcessingError("cancelled");
-    const auto t_reg = Clock::now();
-    result.registration =
-        refine_registration(mesh, input.rasters, lights, photos, visibility, settings.registration, log);
-    if (result.registration.any_applied()) {
-      input.rasters = result.registration.rasters;
-      result.registered_project = registered_project_path(result.output_ply);
-      lights = resolve_lights(input.rasters, result.light_file, placement);  // .lp directions follow the camera
-    }
-    result.seconds_registration = seconds_since(t_reg);
+// Each viewpoint's camera measured against its photos and corrected above the threshold
+// (registration.h): the rest of the run uses the corrected cameras, and an .lp's directions,
+// given in the camera frame, follow them.
+void refine_cameras(FitRun &run, PhotoCache &photos) {
+  if (!run.settings.registration.enabled) return;
+  if (run.progress && !run.progress(0.0f, "registration")) throw ProcessingError("cancelled");
+  FitResult &result = run.result;
+  const auto started = Clock::now();
+  result.registration = refine_registration(run.input.mesh, run.input.rasters, run.lights, photos, run.visibility,
+                                            run.settings.registration, run.log);
+  if (result.registration.any_applied()) {
+    run.input.rasters = result.registration.rasters;
+    result.registered_project = registered_project_path(result.output_ply);
+    run.lights = resolve_lights(run.input.rasters, result.light_file, run.placement);
   }
-  if (progress) progress(0.0f, "colour calibration");
-  ColorPlanBesidePasses color_search(input, settings, light_directions(lights), photos);
+  result.seconds_registration = seconds_since(started);
+}
 
-  auto t = Clock::now();
+// The depth passes (visibility masks restricted to the selection), with every viewpoint's colour
+// plan searched beside them (ColorPlanBesidePasses); a required chart that is missing stops the
+// passes.
+VisibilityMasks visibility_and_colors(FitRun &run, PhotoCache &photos, ColorPlan &colors) {
+  const FitInput &input = run.input;
+  FitResult &result = run.result;
+  if (run.progress) run.progress(0.0f, "colour calibration");
+  ColorPlanBesidePasses color_search(input, run.settings, light_directions(run.lights), photos);
+  const auto started = Clock::now();
   const ProgressFn vis_progress = [&](float f, const char *s) {
-    color_search.rethrow_if_failed();  // a required chart that is missing stops the passes here
-    return !progress || progress(0.4f * f, s);
+    color_search.rethrow_if_failed();
+    return !run.progress || run.progress(0.4f * f, s);
   };
-  VisibilityMasks masks = compute_visibility(mesh, input.rasters, lights, visibility, vis_progress);
-  {
-    const std::string sizes = describe_pass_sizes(visibility.last_pass_sizes());
-    result.depth_passes = std::to_string(masks.camera_passes) + " camera pass(es) for " +
-                          std::to_string(input.rasters.size()) + " photos (photos of one camera share its pass)" +
-                          (sizes.empty() ? std::string() : "; " + sizes);
-  }
+  VisibilityMasks masks = compute_visibility(input.mesh, input.rasters, run.lights, run.visibility, vis_progress);
+  const std::string sizes = describe_pass_sizes(run.visibility.last_pass_sizes());
+  result.depth_passes = std::to_string(masks.camera_passes) + " camera pass(es) for " +
+                        std::to_string(input.rasters.size()) + " photos (photos of one camera share its pass)" +
+                        (sizes.empty() ? std::string() : "; " + sizes);
   restrict_to_vertices(masks, input.vertex_mask);
-  result.seconds_visibility = seconds_since(t);
-  ColorPlan colors = color_search.take(log, result.seconds_colors);
-  const bool correct = colors.any_corrected();
+  result.seconds_visibility = seconds_since(started);
+  colors = color_search.take(run.log, result.seconds_colors);
   result.color_viewpoints_corrected = size_t(std::count_if(
       colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
-  prefetch->finish();
-  t = Clock::now();
-  // Every photo's content (photo_content.h), before any sample is gathered: mostly from the cache.
-  std::vector<PhotoContent> contents(input.rasters.size());
-  std::vector<size_t> photo_bytes(input.rasters.size(), 0);
-  std::vector<std::exception_ptr> photo_errors(input.rasters.size());
+  return masks;
+}
+
+// Every photo's content (photo_content.h), before any sample is gathered (mostly from the cache):
+// the first photo in raster order that cannot be decoded fails the run; photos that are black,
+// saturated or identical, and a photo larger than the photo memory, are logged and reported.
+void check_photos(FitRun &run, PhotoCache &photos) {
+  const std::vector<Raster> &rasters = run.input.rasters;
+  FitResult &result = run.result;
+  std::vector<PhotoContent> contents(rasters.size());
+  std::vector<size_t> photo_bytes(rasters.size(), 0);
+  std::vector<std::exception_ptr> photo_errors(rasters.size());
 #pragma omp parallel for schedule(dynamic, 1)
-  for (long long i = 0; i < (long long)input.rasters.size(); ++i) {
-    const Raster &r = input.rasters[size_t(i)];
+  for (long long i = 0; i < (long long)rasters.size(); ++i) {
+    const Raster &r = rasters[size_t(i)];
     try {
       const auto photo = photos.get(r.image_path, r.width(), r.height());
       contents[size_t(i)] = analyse_photo(*photo);
@@ -504,114 +505,184 @@ FitResult run_fit(const FitInput &given, const FitSettings &settings_in, Visibil
       photo_errors[size_t(i)] = std::current_exception();
     }
   }
-  for (const std::exception_ptr &e : photo_errors)  // the first failing photo, in raster order
+  for (const std::exception_ptr &e : photo_errors)
     if (e) std::rethrow_exception(e);
   const size_t largest_photo = photo_bytes.empty() ? 0 : *std::max_element(photo_bytes.begin(), photo_bytes.end());
-  if (largest_photo > settings.gather.photo_cache_bytes) {
+  const size_t cache_bytes = run.settings.gather.photo_cache_bytes;
+  if (largest_photo > cache_bytes) {
     result.memory_note = "photo memory: a decoded photo needs " + std::to_string((largest_photo >> 20) + 1) +
-                         " MB, more than 'Photo memory (MB)' (" + std::to_string(settings.gather.photo_cache_bytes >> 20) +
+                         " MB, more than 'Photo memory (MB)' (" + std::to_string(cache_bytes >> 20) +
                          " MB): photos are kept one at a time and decoded again for each vertex chunk (slower); "
                          "raise 'Photo memory (MB)' to keep them";
-    log("Vertex BRDF: " + result.memory_note + ".");
+    run.log("Vertex BRDF: " + result.memory_note + ".");
   }
-  result.warnings = check_photo_contents(input.rasters, contents);
+  result.warnings = check_photo_contents(rasters, contents);
   result.warnings.insert(result.warnings.end(), result.registration.warnings.begin(), result.registration.warnings.end());
-  for (const std::string &w : result.warnings) log(w);
+  for (const std::string &w : result.warnings) run.log(w);
+}
+
+// Refuses a run in which no camera sees the mesh, and warns of every raster that sees none of it.
+void check_cameras_see_mesh(FitRun &run, const VisibilityMasks &masks) {
   if (std::all_of(masks.seen_count.begin(), masks.seen_count.end(), [](uint32_t c) { return c == 0; }))
     throw InputError("No raster's camera sees the mesh (every vertex is outside every photo, behind its camera or "
                      "back-facing): the registration does not match this mesh. Check that the project's rasters "
                      "were registered to it. Nothing was written.");
-  for (size_t i = 0; i < input.rasters.size(); ++i)
+  for (size_t i = 0; i < run.input.rasters.size(); ++i)
     if (masks.seen_count[i] == 0) {
-      result.warnings.push_back("WARNING: raster '" + input.rasters[i].label +
-                                "' sees no vertex of the mesh (its camera points elsewhere: check its registration); "
-                                "the other photos were used without it.");
-      log(result.warnings.back());
+      run.result.warnings.push_back("WARNING: raster '" + run.input.rasters[i].label +
+                                    "' sees no vertex of the mesh (its camera points elsewhere: check its registration); "
+                                    "the other photos were used without it.");
+      run.log(run.result.warnings.back());
     }
+}
 
-  result.seconds_photo_checks = seconds_since(t);
-
-  t = Clock::now();
-  decide_diffuse_form(input, lights, masks, photos, [&](SampleChunk &chunk) {
-    if (correct) correct_samples(colors, chunk);
-    apply_light_falloff(chunk, mesh, lights);
-  }, log, settings, result);
-  result.seconds_pilot = seconds_since(t);
-
-  t = Clock::now();
+// Every vertex's samples, gathered chunk by chunk and fitted as they stream (consume_chunk):
+// colour-corrected, checked against the light file and divided by the lights' fall-off first.
+// The material stage's samples are kept in `material_samples` (when it runs). Throws before
+// anything is written when the light file contradicts the photos.
+void gather_and_fit(FitRun &run, PhotoCache &photos, const VisibilityMasks &masks, ColorPlan &colors,
+                    MaterialSampleStore &material_samples, bool with_materials) {
+  const FitInput &input = run.input;
+  const FitSettings &settings = run.settings;
+  const MeshView &mesh = input.mesh;
+  FitResult &result = run.result;
+  const auto started = Clock::now();
   result.diffuse.resize(mesh.vertex_count);
   if (settings.fit_reflectance) result.fits.resize(mesh.vertex_count);
-  LightAgreement agreement(input.rasters.size());  // a light file that contradicts the photos fails below
-  const ProgressFn gather_progress = [&](float f, const char *s) { return !progress || progress(0.4f + 0.55f * f, s); };
-  const bool with_materials = settings.fit_reflectance && settings.materials;  // material stage hook
-  MaterialSampleStore material_samples(with_materials ? mesh.vertex_count : 0);
+  const bool correct = colors.any_corrected();
+  LightAgreement agreement(input.rasters.size());
+  const ProgressFn gather_progress = [&](float f, const char *s) {
+    return !run.progress || run.progress(0.4f + 0.55f * f, s);
+  };
   const NormalStep refine_normals = settings.fit_reflectance && settings.shading_normals.enabled
-                                        ? shading_normal_refiner(input, lights, settings, result)
+                                        ? shading_normal_refiner(input, run.lights, settings, result)
                                         : NormalStep();
+  PhongFitter *fitter = settings.fit_reflectance ? run.fitter : nullptr;
   result.gather = gather_samples(
-      mesh, input.rasters, lights, masks, settings.gather, photos,
+      mesh, input.rasters, run.lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
         if (correct) correct_samples(colors, chunk);
-        agreement.add(chunk, mesh, lights);
-        apply_light_falloff(chunk, mesh, lights);  // after the correction, which need not be linear
-        consume_chunk(chunk, settings.fit_reflectance ? fitter : nullptr, settings.phong, settings.photo_shadows,
-                      refine_normals, settings.shading_normals.rounds, result, result.seconds_fit);
+        agreement.add(chunk, mesh, run.lights);
+        apply_light_falloff(chunk, mesh, run.lights);  // after the correction, which need not be linear
+        consume_chunk(chunk, fitter, settings.phong, settings.photo_shadows, refine_normals,
+                      settings.shading_normals.rounds, result, result.seconds_fit);
         if (with_materials) material_samples.add_chunk(chunk, &result.fits[chunk.first_vertex], settings.phong);
       },
       gather_progress);
-  result.seconds_gather = seconds_since(t);
-  if (refine_normals) summarise_shading_normals(input, masks, settings, log, result);
+  result.seconds_gather = seconds_since(started);
+  if (refine_normals) summarise_shading_normals(input, masks, settings, run.log, result);
   result.light_agreement = weakest_light_agreement(agreement, input.rasters);
-  check_light_agreement(agreement, input.rasters, result.light_file);  // before anything is written
+  check_light_agreement(agreement, input.rasters, result.light_file);
   result.colors = std::move(colors.viewpoints);
-  t = Clock::now();
-  if (with_materials) run_material_stage(input, settings, material_samples, log, result);
+}
+
+// The stages after the per-vertex fit, timed each: materials (materials.h), the neighbour fill,
+// the material labels of the filled vertices, and the albedo deconvolution.
+void stages_after_fit(FitRun &run, const VisibilityMasks &masks, const MaterialSampleStore &material_samples,
+                      bool with_materials) {
+  const FitSettings &settings = run.settings;
+  FitResult &result = run.result;
+  auto t = Clock::now();
+  if (with_materials) run_material_stage(run.input, settings, material_samples, run.log, result);
   result.seconds_materials = seconds_since(t);
   t = Clock::now();
-  if (settings.fit_reflectance) fill_gaps(input, settings, log, result);
+  if (settings.fit_reflectance) fill_gaps(run.input, settings, run.log, result);
   result.seconds_fill = seconds_since(t);
-  if (with_materials) propagate_material_labels(mesh, result.fits, result.materials.label);
+  if (with_materials) propagate_material_labels(run.input.mesh, result.fits, result.materials.label);
   t = Clock::now();
-  if (settings.fit_reflectance && settings.deconvolve_albedo) deconvolve_fit_albedo(input, settings, masks, log, result);
+  if (settings.fit_reflectance && settings.deconvolve_albedo)
+    deconvolve_fit_albedo(run.input, settings, masks, run.log, result);
   result.seconds_deconvolution = seconds_since(t);
+}
 
-  t = Clock::now();
-  build_outputs(input, settings, result);
+// The PLY, its report and, when a camera was corrected, the registered project: committed
+// together under a lock on their folder, so a concurrent run writing the same files waits here.
+// `given` is the caller's input (the registered project rewrites its cameras); `started`: when
+// the outputs' step began (the report's output time).
+void commit_outputs(FitRun &run, const FitInput &given, Clock::time_point started) {
+  const FitSettings &settings = run.settings;
+  FitResult &result = run.result;
+  OutputFolderLock lock(directory_of(result.output_ply));
+  if (settings.overwrite == OverwritePolicy::Refuse)  // again: another run may have written it meanwhile
+    check_output_path(result.output_ply, settings.overwrite, "Output PLY");
+  AtomicOutput ply(result.output_ply), report(report_path_for(result.output_ply));
+  std::unique_ptr<AtomicOutput> project;
+  if (result.registration.any_applied()) {
+    project = std::make_unique<AtomicOutput>(result.registered_project);
+    stage_text_file(*project,
+                    registered_project_text(given.project_path, given.mesh_path, given.rasters, result.registration));
+  }
+  MeshView shaded = run.input.mesh;  // the geometry as given, with the normals the model was fitted with
+  if (!result.shading_normals.empty()) shaded.normals = result.shading_normals.data();
+  stage_result_ply(ply, shaded, result.colors_rgba, result.attributes);
+  result.seconds_output = seconds_since(started);
+  result.report += output_report_line(result);
+  stage_text_file(report, result.report);
+  ply.commit();
+  report.commit((long long)result.report.size());
+  if (project) project->commit();
+}
+
+// Display colours, quality, attributes and report of a finished fit (run/fit_outputs.h), then
+// the files (commit_outputs); the report is logged line by line.
+void write_outputs(FitRun &run, const FitInput &given) {
+  FitResult &result = run.result;
+  const auto started = Clock::now();
+  build_outputs(run.input, run.settings, result);
   if (result.vertices_coloured == 0) {
     result.warnings.push_back("WARNING: no vertex got a colour or a model: every sample was shadowed, saturated or "
                               "unusable (see the counts below).");
-    log(result.warnings.back());
+    run.log(result.warnings.back());
   }
-  result.report = build_report(input, settings, result);
-  {
-    // PLY and report are committed together: a concurrent run writing the same files waits here.
-    OutputFolderLock lock(directory_of(result.output_ply));
-    if (settings.overwrite == OverwritePolicy::Refuse)  // again: another run may have written it meanwhile
-      check_output_path(result.output_ply, settings.overwrite, "Output PLY");
-    AtomicOutput ply(result.output_ply), report(report_path_for(result.output_ply));
-    std::unique_ptr<AtomicOutput> project;
-    if (result.registration.any_applied()) {
-      project = std::make_unique<AtomicOutput>(result.registered_project);
-      const std::string text =
-          registered_project_text(given.project_path, given.mesh_path, given.rasters, result.registration);
-      stage_text_file(*project, text);
-    }
-    MeshView shaded = mesh;  // the geometry as given, with the normals the model was fitted with
-    if (!result.shading_normals.empty()) shaded.normals = result.shading_normals.data();
-    stage_result_ply(ply, shaded, result.colors_rgba, result.attributes);
-    result.seconds_output = seconds_since(t);
-    result.report += "output: " + result.output_ply + " (" + result.output_note + "; written in " +
-                     fixed(result.seconds_output) + " s)\n";
-    stage_text_file(report, result.report);
-    ply.commit();
-    report.commit((long long)result.report.size());
-    if (project) project->commit();
-  }
-
+  result.report = build_report(run.input, run.settings, result);
+  commit_outputs(run, given, started);
   std::istringstream lines(result.report);
-  for (std::string line; std::getline(lines, line);) log(line);
+  for (std::string line; std::getline(lines, line);) run.log(line);
+}
+
+} // namespace
+
+FitResult run_fit(const FitInput &given, const FitSettings &settings, VisibilityBackend &visibility,
+                  PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {
+  validate_input(given);
+  FitRun run{given, settings_for_run(settings, given.mesh, fitter), visibility, fitter, progress, log, {}, {}, {}};
+  FitResult &result = run.result;
+  result.visibility_backend = visibility.name();
+  result.fit_backend = run.settings.fit_reflectance ? fitter->name() : "";
+  resolve_run_lights(run);
+  check_output_paths(run);
+  result.normals_source = describe_normals_source(given.mesh_path);
+  log(result.normals_source + ".");
+
+  // The photos decode in the background while the GL passes run (photo_prefetch.h); a photo that
+  // cannot be decoded fails before any sample is gathered, so before anything is written.
+  const GatherSettings &gather = run.settings.gather;
+  PhotoCache photos(gather.encoding, gather.saturation_level, gather.photo_cache_bytes, gather.host_photos);
+  const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, run.input.rasters);
+  refine_cameras(run, photos);
+  ColorPlan colors;
+  const VisibilityMasks masks = visibility_and_colors(run, photos, colors);
+  prefetch->finish();
+  auto t = Clock::now();
+  check_photos(run, photos);
+  check_cameras_see_mesh(run, masks);
+  result.seconds_photo_checks = seconds_since(t);
+
+  t = Clock::now();
+  const bool correct = colors.any_corrected();
+  decide_diffuse_form(run.input, run.lights, masks, photos, [&](SampleChunk &chunk) {
+    if (correct) correct_samples(colors, chunk);
+    apply_light_falloff(chunk, run.input.mesh, run.lights);
+  }, log, run.settings, result);
+  result.seconds_pilot = seconds_since(t);
+
+  const bool with_materials = run.settings.fit_reflectance && run.settings.materials;
+  MaterialSampleStore material_samples(with_materials ? run.input.mesh.vertex_count : 0);
+  gather_and_fit(run, photos, masks, colors, material_samples, with_materials);
+  stages_after_fit(run, masks, material_samples, with_materials);
+  write_outputs(run, given);
   if (progress) progress(1.0f, "done");
-  return result;
+  return std::move(run.result);
 }
 
 } // namespace vbrdf

@@ -1,4 +1,4 @@
-#include "io/output_file.h"
+#include "base/output_file.h"
 
 #include <algorithm>
 #include <atomic>
@@ -148,6 +148,24 @@ OutputFolderLock::~OutputFolderLock() {
     ::flock(fd_, LOCK_UN);
     ::close(fd_);
   }
+}
+
+void stage_text_file(AtomicOutput &out, const std::string &text) {
+  std::FILE *f = std::fopen(out.temporary().c_str(), "wb");
+  const bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  const bool closed = f && std::fclose(f) == 0;
+  if (!ok || !closed) {
+    const std::string cause = out.failure_cause();
+    std::remove(out.temporary().c_str());
+    throw ProcessingError("Cannot write '" + out.path() + "': " + cause + ". Free space or choose another folder; " +
+                          (file_exists(out.path()) ? "the previous file is unchanged." : "nothing was written."));
+  }
+}
+
+void write_text_file_atomically(const std::string &path, const std::string &text) {
+  AtomicOutput out(path);
+  stage_text_file(out, text);
+  out.commit((long long)text.size());
 }
 
 } // namespace vbrdf

@@ -20,14 +20,15 @@
 #include "inputs/light_file.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
-#include "fit/pipeline.h"
-#include "io/output_file.h"
+#include "coverage/coverage_settings.h"
+#include "coverage/new_view.h"
+#include "base/output_file.h"
 #include "samples/samples.h"
 #include "calibration/sphere_lights.h"
 #include "inputs/viewpoints.h"
 #include "coverage/import_photos.h"
 #include "coverage/suggest_learning.h"
-#include "visibility/visibility.h"
+#include "visibility/visibility_masks.h"
 
 namespace vbrdf {
 
@@ -36,34 +37,6 @@ namespace vbrdf {
 // allowed (their names go to `unused` when given). Directions are returned in world coordinates.
 std::vector<std::array<float, 3>> lights_for_rasters(const std::vector<Raster> &rasters, const std::string &lp_path,
                                                      std::vector<std::string> *unused = nullptr);
-
-struct CoverageSettings {
-  GatherSettings gather;            // T_s and T_d classify samples and drive the suggestions
-  VisibilitySettings visibility;
-  VisibilityChoice visibility_choice = VisibilityChoice::Auto;
-  LightSuggestionSettings suggest;  // its thresholds are replaced by gather's
-  int min_diffuse = 1;              // diffuse samples a vertex needs to count as diffusely covered
-  int min_specular = 1;             // specular samples it needs to count as specularly covered
-  int viewpoint_raster = -1;        // suggestions for the viewpoint of this raster; -1: the last raster
-  // With a fit (CoverageInput::dq/sq): a covered vertex whose DQ (SQ) is below this still needs
-  // diffuse (specular) samples, weighted (poor - q) / poor; uncovered vertices weigh 1.
-  float poor_dq = 1.5f;
-  float poor_sq = 1.5f;
-  float tolerance_deg = 0;          // suggestions robust to this light placement error (0: exact)
-  float failure_cone_deg = 20;      // suggest_light_learning: learn from failed predictions (0: off)
-  // Learn from the previous suggestion file (same path): when photos were added to the viewpoint
-  // since, its recommended light counts as followed, i.e. as a light whose promises are checked
-  // (suggest_light_learning), together with the lights followed before. Needs write_files.
-  bool learn_from_previous = true;
-  std::string light_file;           // "" = find_default_light_file (light_file.h); .json / .dome: light_source.h
-  float dome_radius = 0;            // as FitSettings: the .lp's directions as point lights on a dome
-  float light_unit_scale = 0;       // as FitSettings: mesh units per unit of the light file's positions
-  std::string suggestion_file;      // "" = <project folder>/<project name>_next_light.txt
-  // An existing suggestion file (and its vertex list): replaced, the log saying so (the default:
-  // each run replaces the last one and learns from it), or the run refused before any work.
-  OverwritePolicy overwrite = OverwritePolicy::Replace;
-  bool write_files = true;          // false: nothing is written (result only)
-};
 
 struct CoverageInput {
   MeshView mesh;
@@ -76,20 +49,6 @@ struct CoverageInput {
   // for no light, is never listed as needing a new viewpoint and is not counted. Empty: all.
   std::vector<uint8_t> vertex_mask;
 };
-
-// Why a vertex can only be covered from a new viewpoint.
-enum NewViewReason : uint8_t {
-  kNewViewUnseen = 1,    // no photo sees it
-  kNewViewDiffuse = 2,   // needs diffuse samples; no placeable light of any viewpoint gives one
-  kNewViewSpecular = 4,  // needs specular samples; no placeable light of any viewpoint gives one
-};
-
-// Per vertex, the NewViewReason of a vertex only a new viewpoint can cover (0: a registered one
-// can): unseen (class kUnseen), or needing diffuse (specular) samples while no viewpoint that sees
-// it cleanly (visible[i][v], one mask per viewpoint) has a placeable light that would give one.
-std::vector<uint8_t> new_view_reasons(const MeshView &mesh, const std::vector<uint8_t> &classes,
-                                      const std::vector<std::vector<uint8_t>> &visible,
-                                      const std::vector<Viewpoint> &viewpoints, const LightSuggestionSettings &s);
 
 struct CoverageResult {
   std::vector<CoverageCounts> counts;      // per vertex
@@ -124,10 +83,9 @@ struct CoverageResult {
 // (<suggestion file stem>_new_view_vertices.txt), both atomically. Suggestions learn from the
 // viewpoint's photos and, with settings.learn_from_previous, from the previous suggestion file at
 // the same path (suggest_light_learning); `recommended` is the valid suggestion promising more
-// weighted coverage that does not repeat a failed light. Needs a mesh with normals and at least
-// one raster (InputError otherwise, as validate_input). Throws InputError when dq/sq do not have
-// one value per vertex, when settings.viewpoint_raster is out of range, or when no .lp has an
-// entry for every raster.
+// weighted coverage that does not repeat a failed light. Checks the mesh and rasters as the fit
+// does (inputs/input_check.h). Throws InputError when dq/sq do not have one value per vertex, when
+// settings.viewpoint_raster is out of range, or when no light file serves (resolve_light_file).
 CoverageResult run_coverage(const CoverageInput &input, const CoverageSettings &settings, VisibilityBackend &visibility,
                             const ProgressFn &progress, const LogFn &log);
 

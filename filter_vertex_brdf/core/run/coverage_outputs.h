@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "coverage/coverage_run.h"
+#include "run/coverage_run.h"
 
 namespace vbrdf {
 

@@ -59,4 +59,9 @@ private:
   int fd_ = -1;
 };
 
+// Writes a text file atomically (reports, light files, tables), replacing an existing one.
+void write_text_file_atomically(const std::string &path, const std::string &text);
+// The same, into out.temporary() only (ProcessingError naming the cause on failure).
+void stage_text_file(AtomicOutput &out, const std::string &text);
+
 } // namespace vbrdf

@@ -1,4 +1,4 @@
-#include "io/coverage_outputs.h"
+#include "run/coverage_outputs.h"
 
 #include <cstdlib>
 #include <fstream>

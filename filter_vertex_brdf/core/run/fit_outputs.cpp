@@ -1,4 +1,4 @@
-#include "io/fit_outputs.h"
+#include "run/fit_outputs.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +8,7 @@
 #include "base/vec3.h"
 #include "inputs/photo.h"
 #include "io/result_schema.h"
+#include "io/vertex_quality.h"
 
 namespace vbrdf {
 
@@ -58,17 +59,8 @@ bool displayed_reflectance(const FitResult &r, size_t v, float rho[3]) {
 
 std::string report_path_for(const std::string &ply) { return strip_extension(ply) + "_report.txt"; }
 
-void neutral_quality_for_unmodelled(const std::vector<VertexFit> &fits, std::vector<float> &quality) {
-  std::vector<float> modelled;
-  for (size_t v = 0; v < fits.size() && v < quality.size(); ++v)
-    if (fits[v].status != kFitNone && std::isfinite(quality[v])) modelled.push_back(quality[v]);
-  float neutral = 0.0f;
-  if (!modelled.empty()) {
-    std::nth_element(modelled.begin(), modelled.begin() + std::ptrdiff_t(modelled.size() / 2), modelled.end());
-    neutral = modelled[modelled.size() / 2];
-  }
-  for (size_t v = 0; v < fits.size() && v < quality.size(); ++v)
-    if (fits[v].status == kFitNone || !std::isfinite(quality[v])) quality[v] = neutral;
+std::string output_report_line(const FitResult &r) {
+  return "output: " + r.output_ply + " (" + r.output_note + "; written in " + fixed(r.seconds_output) + " s)\n";
 }
 
 namespace {
@@ -110,7 +102,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
       rec.diffuse_deconvolved = v < r.albedo_deconvolved.size() ? float(r.albedo_deconvolved[v]) : 0.0f;
       for (int k = 0; k < 3; ++k) rec.mesh_normal[k] = input.mesh.normals[3 * v + size_t(k)];
       rec.normal_moved = v < r.normal_moved.size() ? r.normal_moved[v] : -1.0f;
-      r.quality[v] = settings.quality == QualityOutput::SQ ? f.sq : settings.quality == QualityOutput::RMSE ? f.rmse : f.dq;
+      r.quality[v] = vertex_quality(f, settings.quality);
       r.fit_full += f.status == kFitFull, r.fit_diffuse_only += f.status == kFitDiffuseOnly, r.fit_none += f.status == kFitNone;
       r.fit_weak += f.status == kFitFromWeakSamples, r.fit_neighbours += f.status == kFitFromNeighbours;
       r.fit_converged += f.status == kFitFull && f.converged, r.fit_iterations += f.iterations;

@@ -20,16 +20,15 @@
 #include "fit/photo_shadows.h"
 #include "fit/shading_normals.h"
 #include "base/mesh_view.h"
-#include "io/output_file.h"
+#include "base/output_file.h"
 #include "io/output_ply.h"
+#include "io/vertex_quality.h"  // QualityOutput
 #include "samples/samples.h"
 #include "inputs/viewpoints.h"
 #include "registration/registration.h"
 #include "visibility/visibility.h"
 
 namespace vbrdf {
-
-enum class QualityOutput { DQ = 0, SQ = 1, RMSE = 2 };
 
 // The fit's T_d (N.L below which a sample is "grazing"): 0.2, not the thesis's 0.5. With errors
 // weighted by N.L, grazing samples help more than they hurt: over the whole visible surface the
@@ -68,12 +67,12 @@ struct FitSettings {
   // viewpoint; 8 per viewpoint = one group each, viewpoints in order of their first raster.
   std::vector<float> chart_corners;
   ExposureMode exposure = ExposureMode::Auto;  // per-photo normalisation by the chart's neutrals
-  std::string light_file;   // "" = find_default_light_file (light_file.h); .lp, .json or .dome (light_source.h)
+  std::string light_file;   // "" = the default rule (light_file.h resolve_light_file); .lp, .json or .dome (light_source.h)
   float dome_radius = 0;     // > 0: the .lp's directions are point lights this far from the mesh's centre
   float light_unit_scale = 0;  // mesh units per unit of the light file's positions (0: .json 1, .dome required)
   std::string output_ply;   // "" = <project folder>/<project name>_brdf.ply
   // An existing output PLY / report: replaced (and the log says so) or the run refused before any
-  // work (io/output_file.h). Replace by default: re-running a script into the same file is the
+  // work (base/output_file.h). Replace by default: re-running a script into the same file is the
   // normal loop, and the inputs themselves can never be outputs.
   OverwritePolicy overwrite = OverwritePolicy::Replace;
   // Vertices no photo sees keep "no model" unless within this many edges of a modelled vertex
@@ -121,9 +120,10 @@ struct FitInput {
 
 
 
-// Checks everything that can be checked before any work: non-empty mesh with normals, at least
-// one raster, every raster with a valid shot and an existing photo of the shot's size.
-// Throws InputError with a message naming the item and the fix.
+// Checks everything that can be checked before any work (inputs/input_check.h, as coverage does):
+// non-empty mesh with normals, a selection of one entry per vertex (or none), at least one raster,
+// every raster with a valid, registered shot and an existing photo. Throws InputError with a
+// message naming the item and the fix.
 void validate_input(const FitInput &input);
 
 struct FitResult {
@@ -180,7 +180,7 @@ struct FitResult {
 
 // Runs the pipeline and writes the PLY and the report (<ply stem>_report.txt). Nothing is
 // written if any stage fails; the two files are committed together under a lock on their folder
-// (io/output_file.h), so concurrent runs leave one run's complete pair. `fitter` may be null when settings.fit_reflectance is false.
+// (base/output_file.h), so concurrent runs leave one run's complete pair. `fitter` may be null when settings.fit_reflectance is false.
 // Throws InputError / ProcessingError.
 FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
                   PhongFitter *fitter, const ProgressFn &progress, const LogFn &log);
