@@ -72,7 +72,7 @@ vbrdf::GrayLoader gray_loader(const std::vector<vbrdf::Raster> &rasters, const s
     const float fraction = std::min(0.95f, float(++*loads) / float(std::max<size_t>(1, expected)));
     if (progress && !progress(fraction, "finding the sphere and its highlights"))
       throw vbrdf::ProcessingError("cancelled");
-    const vbrdf::Photo photo = vbrdf::load_photo(r.image_path, p.encoding, 0.99f, r.width(), r.height());
+    const vbrdf::Photo photo = vbrdf::load_photo(r.image_path, p.encoding, vbrdf::kSaturationLevel, r.width(), r.height());
     return photo.pixels.depth() == CV_16U ? gray_of<uint16_t>(photo) : gray_of<uint8_t>(photo);
   };
 }

@@ -1,5 +1,5 @@
 #pragma once
-// The small vocabulary of the core: 3-vectors, pi, and the number formats and timer of the reports;
+// The small vocabulary of the core: 3-vectors, pi (angles.h), and the number formats and timer of the reports;
 // one definition instead of a copy per file. 3-vectors come in three forms, each where it fits:
 //  - plain float[3] / std::array<float, 3> at interfaces and in storage (the layout MeshView, the
 //    samples and the GL buffers use), with dot3 / cross3 / normalize3 below;
@@ -11,9 +11,9 @@
 #include <sstream>
 #include <string>
 
-namespace vbrdf {
+#include "base/angles.h"  // kPi
 
-constexpr double kPi = 3.14159265358979323846;
+namespace vbrdf {
 
 template <typename T>
 inline T dot3(const T *a, const T *b) {

@@ -10,8 +10,10 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/mcc.hpp>
 
+#include "base/clip_level.h"
 #include "base/color_difference.h"
 #include "base/errors.h"
+#include "base/luminance.h"
 #include "inputs/photo.h"
 
 namespace vbrdf {
@@ -34,8 +36,6 @@ std::string photo_name(const std::vector<std::string> &names, size_t i) {
   if (i < names.size() && !names[i].empty()) return "'" + names[i] + "'";
   return "photo " + std::to_string(i + 1);
 }
-
-double luminance(const float c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -70,8 +70,8 @@ bool sample_rgb(const cv::Mat &img, double x, double y, cv::Vec3f &out) {
 bool neutral_row_reversed(const PatchMeasurement &m) {
   int forward = 0, backward = 0;
   for (int k = kFirstNeutralPatch; k + 1 < kChartPatches; ++k)
-    forward += luminance(m.rgb[k].data()) > luminance(m.rgb[k + 1].data());
-  for (int k = 5; k > 0; --k) backward += luminance(m.rgb[k].data()) > luminance(m.rgb[k - 1].data());
+    forward += luminance_double(m.rgb[k].data()) > luminance_double(m.rgb[k + 1].data());
+  for (int k = 5; k > 0; --k) backward += luminance_double(m.rgb[k].data()) > luminance_double(m.rgb[k - 1].data());
   return backward == 5 && forward < 4;
 }
 
@@ -144,7 +144,7 @@ void fit_tone_curve(const std::vector<int> &idx, const PatchColors &measured, co
                     ColorCorrection &out) {
   std::vector<double> xs, ys;
   for (int k : idx) {
-    const double x = luminance(measured[k].data()), y = luminance(reference[k].data());
+    const double x = luminance_double(measured[k].data()), y = luminance_double(reference[k].data());
     if (k >= kFirstNeutralPatch && x > 0 && y > 0) {
       xs.push_back(std::log(x));
       ys.push_back(std::log(y));
@@ -317,7 +317,7 @@ PatchColors pooled_patches(const std::vector<PatchMeasurement> &patches, const s
     for (size_t p = 0; p < patches.size(); ++p)
       if (brightness[p] > 0 && patches[p].usable[k]) {
         photos.push_back(p);
-        lum.push_back(luminance(patches[p].rgb[k].data()) / brightness[p]);
+        lum.push_back(luminance_double(patches[p].rgb[k].data()) / brightness[p]);
       }
     usable[k] = !photos.empty();
     if (!usable[k]) continue;
@@ -635,8 +635,8 @@ PatchMeasurement measure_chart_at(const cv::Mat &img, const ChartLocation &chart
           inside = false;
           break;
         }
-        clipped += v[0] >= 0.995f || v[1] >= 0.995f || v[2] >= 0.995f;
-        s.emplace_back(0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2], v);
+        clipped += v[0] >= kClippedLinearValue || v[1] >= kClippedLinearValue || v[2] >= kClippedLinearValue;
+        s.emplace_back(luminance_double(&v[0]), v);
       }
     if (!inside) continue;
     // Trimmed mean: specks of dust, a glint or the patch edge do not move it.
@@ -649,7 +649,7 @@ PatchMeasurement measure_chart_at(const cv::Mat &img, const ChartLocation &chart
     sum /= double(hi - lo);
     for (int c = 0; c < 3; ++c) m.rgb[k][c] = float(sum[c]);
     m.clipped[k] = float(clipped) / float(s.size());
-    m.usable[k] = m.clipped[k] < 0.02f && luminance(m.rgb[k].data()) > 1e-3;
+    m.usable[k] = m.clipped[k] < 0.02f && luminance_double(m.rgb[k].data()) > 1e-3;
   }
   return m;
 }
@@ -689,8 +689,8 @@ void ColorCorrection::apply(const float in_raw[3], float out[3]) const {
 double neutral_scale(const PatchColors &measured, const PatchColors &reference, const PatchFlags &usable) {
   std::vector<double> ratios;
   for (int k = kFirstNeutralPatch; k < kChartPatches; ++k) {
-    const double y = luminance(measured[k].data());
-    if (usable[k] && y > 0) ratios.push_back(luminance(reference[k].data()) / y);
+    const double y = luminance_double(measured[k].data());
+    if (usable[k] && y > 0) ratios.push_back(luminance_double(reference[k].data()) / y);
   }
   return median_of(ratios);
 }

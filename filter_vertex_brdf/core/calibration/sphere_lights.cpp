@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "base/clip_level.h"
 #include "base/errors.h"
 #include "inputs/photo.h"
 #include "base/vec3.h"
@@ -613,7 +614,7 @@ double angle_deg(const double a[3], const double b[3]) {
   double cr[3];
   cross3(a, b, cr);
   // atan2 keeps precision for small angles, where acos does not.
-  return std::atan2(std::sqrt(dot3(cr, cr)), dot3(a, b)) * 180.0 / kPi;
+  return degrees(std::atan2(std::sqrt(dot3(cr, cr)), dot3(a, b)));
 }
 
 cv::Mat gray_image(const cv::Mat &image, bool decode_srgb) {
@@ -726,7 +727,7 @@ Highlight find_highlight(const cv::Mat &gray, const SphereCircle &c, const Highl
       ux += px;
       uy += py;
       ++area;
-      saturated = saturated || r[x] >= 0.995f;
+      saturated = saturated || r[x] >= kClippedLinearValue;
     }
   }
   h.found = true;

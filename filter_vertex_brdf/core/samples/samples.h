@@ -86,7 +86,7 @@ struct GatherSettings {
   float specular_threshold = 0.9f;   // T_s on R.E
   float diffuse_threshold = 0.5f;    // T_d on N.L
   PhotoEncoding encoding = PhotoEncoding::Auto;
-  float saturation_level = 0.99f;    // fraction of the maximum code value counted as clipped
+  float saturation_level = kSaturationLevel;   // fraction of the maximum code value counted as clipped
   size_t photo_cache_bytes = size_t(2) << 30;  // decoded photos kept in memory
   // Photos the host application has already decoded (the plugin: MeshLab's raster images), read
   // in place instead of decoded again; they take none of photo_cache_bytes. Empty: decode files.
