@@ -10,8 +10,8 @@
 
 #include "base/mesh_view.h"
 #include "fit/phong_fit.h"
-#include "samples/diffuse_form.h"
-#include "samples/lobe.h"
+#include "model/diffuse_form.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 
