@@ -1,6 +1,7 @@
 #include "fit/materials.h"
 
 #include "base/mesh_adjacency.h"
+#include "base/number_format.h"
 #include "fit/heldout_folds.h"
 #include "fit/label_spread.h"
 #include "fit/material_labels.h"
@@ -82,14 +83,6 @@ std::vector<std::vector<uint8_t>> held_out_tables(const std::vector<uint8_t> &pr
     tables.push_back(std::move(held));
   }
   return tables;
-}
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
 }
 
 } // namespace
