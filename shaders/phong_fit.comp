@@ -23,7 +23,7 @@ layout(local_size_x = 64) in;
 struct Sample {  // core/samples/samples.h Sample, 28 bytes
   float r, g, b;
   float d;             // N.L
-  float s;             // the lobe's cosine: R.E or N.H (samples/lobe.h)
+  float s;             // the lobe's cosine: R.E or N.H (model/lobe.h)
   uint raster_flags;   // raster | flags << 16 | resolution << 26
   float footprint;     // the normal variance over the photo's pixel footprint (samples/footprint.h)
 };
@@ -48,10 +48,14 @@ uniform float u_kd_max, u_ks_max, u_specular_threshold;
 uniform int u_max_iterations, u_min_specular, u_min_lobe;
 uniform float u_lobe_threshold;  // both thresholds already on the lobe's cosine (lobe_threshold())
 uniform int u_half_angle_lobe;   // 1: s is N.H (SQ's sampling term is then 2 s^2 - 1, lobe_as_r_dot_e)
-uniform int u_ggx_lobe;          // 1: the lobe is GGX's D(N.H)/D(1), not s^alpha (samples/lobe.h lobe_value)
+uniform int u_ggx_lobe;          // 1: the lobe is GGX's D(N.H)/D(1), not s^alpha (model/lobe.h lobe_value)
 
 const uint kUnusable = 0x13Fu;  // kNotSeen | kShadowed | kSaturated | kMixedPixel (samples.h)
 const uint kStatusDiffuseOnly = 1u, kStatusFull = 2u;
+// The model's constants, each named once (model/lobe.h; tests/unit/test_model_constants.cpp checks
+// every named constant here against the C++ model and fails on a bare copy of its value).
+const float kMaxFootprintVariance = 0.18;  // the clamp on a sample's footprint variance
+const float kLobeLogFloor = -80.0;         // the floor on alpha ln s: no ln 0, no denormals
 
 struct Obs {
   vec3 p;      // pixel value / g_pixel_scale
@@ -90,17 +94,17 @@ float ln_s(float s) {
 }
 
 // GGX's D(N.H)/D(1) with a^2 = 2 / (alpha + 2), seen through a pixel footprint of normal variance
-// v (samples/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, 0.18), 1), the value
+// v (model/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, kMaxFootprintVariance), 1), the value
 // (a^2 / a_f^2) r^2), for s in (0, 1].
 float ggx_lobe(float s, float alpha, float v) {
-  const float a2 = 2.0 / (alpha + 2.0), a2f = min(a2 + min(max(v, 0.0), 0.18), 1.0);
+  const float a2 = 2.0 / (alpha + 2.0), a2f = min(a2 + min(max(v, 0.0), kMaxFootprintVariance), 1.0);
   const float den = a2f + (1.0 - s * s) * (1.0 - a2f);
   return a2 * a2f / (den * den);
 }
 
 // Its derivative in t = ln(alpha) (lobe.h lobe_dvalue_dlog_alpha), for s in (0, 1], or s = 1 with v > 0.
 float ggx_lobe_dt(float s, float alpha, float v) {
-  const float a2 = 2.0 / (alpha + 2.0), u = 1.0 - s * s, a2f = a2 + min(max(v, 0.0), 0.18);
+  const float a2 = 2.0 / (alpha + 2.0), u = 1.0 - s * s, a2f = a2 + min(max(v, 0.0), kMaxFootprintVariance);
   const float da2_dt = -2.0 * alpha / ((alpha + 2.0) * (alpha + 2.0));
   if (a2f >= 1.0) return da2_dt;
   const float den = a2f + u * (1.0 - a2f), r = a2f / den;
@@ -112,7 +116,7 @@ float ggx_lobe_dt(float s, float alpha, float v) {
 float lobe(float s, float alpha, float v) {
   if (!(s > 0.0)) return 0.0;
   if (u_ggx_lobe != 0) return ggx_lobe(min(s, 1.0), alpha, v);
-  return exp(max(alpha * ln_s(min(s, 1.0)), -80.0));
+  return exp(max(alpha * ln_s(min(s, 1.0)), kLobeLogFloor));
 }
 
 // Reads sample i; false when it is not usable (or dropped). Same usability rule as the reference,
@@ -253,7 +257,7 @@ void objective(inout Linear L, float alpha) {
     const bool lobed = L.ks > 0.0 && x.s > 0.0;
     const bool ggx = u_ggx_lobe != 0;
     const float lx = lobed && !ggx ? ln_s(min(x.s, 1.0)) : 0.0;
-    const float g = lobed ? (ggx ? ggx_lobe(min(x.s, 1.0), alpha, x.v) : exp(max(alpha * lx, -80.0))) : 0.0;
+    const float g = lobed ? (ggx ? ggx_lobe(min(x.s, 1.0), alpha, x.v) : exp(max(alpha * lx, kLobeLogFloor))) : 0.0;
     const vec3 r = x.p - L.rho * x.d - vec3(L.ks * g);
     kahan_add(e, comp, x.w * dot(r, r));
     if (lobed && (x.s < 1.0 || (ggx && x.v > 0.0))) {  // ln s finite and non-zero, or a footprint's peak

@@ -4,9 +4,9 @@
 // are "#version 330 core" + this file + their own main() (relight/phong_model_source.h); there is
 // no #version here.
 //
-// Contract (the CPU's evaluate_phong, samples/lobe.h, samples/diffuse_form.h, term for term):
+// Contract (the CPU's evaluate_phong, model/lobe.h, model/diffuse_form.h, term for term):
 //   f = rho d + k_s g(s, alpha),  rho = k_d C,  unit irradiance; g = max(s, 0)^alpha, or GGX's
-//      D(N.H)/D(1) with a^2 = 2 / (alpha + 2) when u_ggx_lobe != 0 (samples/lobe.h lobe_value),
+//      D(N.H)/D(1) with a^2 = 2 / (alpha + 2) when u_ggx_lobe != 0 (model/lobe.h lobe_value),
 //      seen through the pixel's footprint: the normal's variance over one box pixel from the
 //      fragment's derivatives (pixel_footprint_variance; samples/footprint.h takes the same from
 //      the mesh for a photo's pixel resampled at a vertex), ggx_lobe_through_footprint
@@ -31,7 +31,12 @@ uniform int u_ggx_lobe;               // 1: GGX lobe on N.H (LobeForm::GgxNH)
 uniform float u_coat_index;           // kCoatIndex
 uniform float u_coat_min_cosine;     // kCoatMinCosine
 
-// samples/diffuse_form.h coat_transmission.
+// The model's constants, each named once (model/lobe.h; tests/unit/test_model_constants.cpp checks
+// every named constant here against the C++ model and fails on a bare copy of its value).
+const float kMaxFootprintVariance = 0.18;  // the clamp on the footprint's normal variance
+const float kLobeLogFloor = -80.0;         // the floor on alpha ln s: no ln 0, no denormals
+
+// model/diffuse_form.h coat_transmission.
 float coat_transmission(float c) {
   c = clamp(c, 0.0, 1.0);
   float sin_t = sqrt(max(0.0, 1.0 - c * c)) / u_coat_index;
@@ -41,7 +46,7 @@ float coat_transmission(float c) {
   return 1.0 - 0.5 * (rs * rs + rp * rp);
 }
 
-// samples/diffuse_form.h diffuse_factor; `coated` in [0, 1] (interpolated vertex flag).
+// model/diffuse_form.h diffuse_factor; `coated` in [0, 1] (interpolated vertex flag).
 float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
   if (!(coated > 0.0) || !(n_dot_l > 0.0)) return n_dot_l;
   float t1 = coat_transmission(1.0);
@@ -49,7 +54,7 @@ float diffuse_factor(float n_dot_l, float n_dot_e, float coated) {
   return mix(n_dot_l, coat, min(coated, 1.0));
 }
 
-// samples/lobe.h lobe_cosine: R.E, or N.H (0 when L = -E).
+// model/lobe.h lobe_cosine: R.E, or N.H (0 when L = -E).
 float lobe_cosine(vec3 n, vec3 l, vec3 e) {
   vec3 h = l + e;
   if (u_half_angle_lobe != 0) return dot(h, h) > 1e-12 ? dot(n, h) / length(h) : 0.0;
@@ -65,19 +70,19 @@ float pixel_footprint_variance(vec3 n) {
   return v >= 0.0 ? v : 0.0;  // NaN from a degenerate normal: no footprint
 }
 
-// k_s g(s, alpha) for s > 0: s^alpha with the exponent's logarithm floored at -80 (no denormals,
+// k_s g(s, alpha) for s > 0: s^alpha with the exponent's logarithm floored at kLobeLogFloor (no denormals,
 // no NaN), or the GGX lobe (a positive denominator for alpha >= 0) seen through a footprint of
-// normal variance v (samples/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, 0.18), 1)).
+// normal variance v (model/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, kMaxFootprintVariance), 1)).
 float phong_specular(float ks, float alpha, float s, float v) {
   if (!(ks > 0.0) || !(s > 0.0)) return 0.0;
   float c = min(s, 1.0);
   if (u_ggx_lobe != 0) {
     float a2 = 2.0 / (max(alpha, 0.0) + 2.0);
-    float a2f = min(a2 + min(max(v, 0.0), 0.18), 1.0);
+    float a2f = min(a2 + min(max(v, 0.0), kMaxFootprintVariance), 1.0);
     float den = a2f + (1.0 - c * c) * (1.0 - a2f);
     return ks * a2 * a2f / (den * den);  // as phong_fit.comp's ggx_lobe and lobe.h
   }
-  return ks * exp(max(alpha * log(c), -80.0));
+  return ks * exp(max(alpha * log(c), kLobeLogFloor));
 }
 
 // The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value; v: the

@@ -128,7 +128,7 @@ std::string light_file(const RichParameterList &params) { return path(params, kL
 // --- Sample classification and photos -----------------------------------------------------------
 
 void add_specular_threshold(RichParameterList &params) {
-  params.addParam(RichFloat(kSpecularThreshold, vbrdf::GatherSettings().specular_threshold,
+  params.addParam(RichFloat(kSpecularThreshold, vbrdf::kDefaultSpecularThreshold,
                             "Specular threshold (R.E)",
                             "A lit sample whose mirror direction R is this close to the view direction E "
                             "(R.E above the threshold, in (0,1]) is a highlight: excluded from the diffuse "
@@ -140,7 +140,7 @@ void add_diffuse_threshold(RichParameterList &params, DiffuseThresholdUse use) {
   const QString common = "A lit sample with N.L below the threshold (in [0,1)) is grazing: noisy and sensitive to "
                          "normal errors. ";
   params.addParam(RichFloat(
-      kDiffuseThreshold, fit ? vbrdf::kFitDiffuseThreshold : kCoverageDiffuseThreshold, "Diffuse threshold (N.L)",
+      kDiffuseThreshold, fit ? vbrdf::kFitDiffuseThreshold : vbrdf::kCoverageDiffuseThreshold, "Diffuse threshold (N.L)",
       common + (fit ? "The fit uses grazing samples for the diffuse colour and the fit only where a vertex has no "
                       "others. 0.2 measured best (the thesis used 0.5)."
                     : "It does not count as diffuse coverage. 0.5 (the thesis's value, above the fit's 0.2) asks "
@@ -160,7 +160,7 @@ vbrdf::PhotoEncoding photo_encoding(const RichParameterList &params) {
 }
 
 void add_shadow_map_size(RichParameterList &params) {
-  params.addParam(RichInt(kShadowMapSize, kDefaultShadowMapSize, "Shadow map size",
+  params.addParam(RichInt(kShadowMapSize, vbrdf::kDefaultShadowMapSize, "Shadow map size",
                           "Resolution (pixels per side) of the depth map rendered from each light direction "
                           "over the mesh bounds (OpenGL visibility and cast shadows). 0: automatic, from the "
                           "mesh's edge length (a texel about a quarter of an edge, 1024 to 4096). Otherwise "
@@ -175,7 +175,7 @@ int shadow_map_size(const RichParameterList &params) {
 
 void add_photo_and_visibility(RichParameterList &params) {
   add_photo_encoding(params);
-  params.addParam(RichFloat(kSaturationLevel, vbrdf::GatherSettings().saturation_level, "Saturation level",
+  params.addParam(RichFloat(kSaturationLevel, vbrdf::kSaturationLevel, "Saturation level",
                             "Fraction of the maximum code value (in (0,1]) at or above which a channel counts "
                             "as clipped; samples touching a clipped pixel are not used (nor counted as "
                             "coverage)."));
@@ -184,7 +184,7 @@ void add_photo_and_visibility(RichParameterList &params) {
                            "How occlusion from the camera and cast shadows from each light are computed. "
                            "Auto: OpenGL depth passes in MeshLab's context when it supports them, else the "
                            "CPU. CPU: exact ray casting (slower)."));
-  params.addParam(RichFloat(kDepthTolerance, vbrdf::VisibilitySettings().depth_tolerance, "Depth tolerance",
+  params.addParam(RichFloat(kDepthTolerance, vbrdf::kDefaultDepthTolerance, "Depth tolerance",
                             "A vertex counts as visible (or lit) when it is at most this far behind the first "
                             "surface along the ray, as a fraction of the bounding-box diagonal."));
   add_shadow_map_size(params);
@@ -223,7 +223,7 @@ void read_visibility(const RichParameterList &params, vbrdf::VisibilityChoice &c
 // --- Coverage and fit ---------------------------------------------------------------------------
 
 void add_min_specular_samples(RichParameterList &params) {
-  params.addParam(RichInt(kMinSpecularSamples, kDefaultMinSpecularSamples, "Min specular samples",
+  params.addParam(RichInt(kMinSpecularSamples, vbrdf::kDefaultMinSpecularSamples, "Min specular samples",
                           "Highlight samples (R.E above the specular threshold, lit, unsaturated) a vertex "
                           "needs before k_s and shininess are fitted; with fewer the fit gives it a "
                           "diffuse-only model (k_s = 0), which guards against 'diffuse holes' (k_d ~ 0, huge "

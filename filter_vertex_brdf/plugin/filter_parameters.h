@@ -81,10 +81,8 @@ extern const char *const kColorCorrection;        // "colorCorrection"
 extern const char *const kChartCorners;           // "chartCorners"
 extern const char *const kExposureNormalisation;  // "exposureNormalisation"
 
-// Defaults that a reader of the code (or a test) may need by name.
-constexpr int kDefaultMinSpecularSamples = 2;  // = vbrdf::PhongFitOptions().min_specular_samples
-constexpr int kDefaultShadowMapSize = 0;       // automatic (vbrdf::resolved_shadow_map_size)
-constexpr float kCoverageDiffuseThreshold = 0.5f;  // the thesis's T_d (vbrdf::GatherSettings' default)
+// Every default comes from the core's table (core/model/defaults.h), which the core's settings
+// structs read too.
 
 // --- Light file (.lp) ---------------------------------------------------------------------------
 // "" = the default light-file rule (vbrdf::resolve_light_file). Returned as given: the

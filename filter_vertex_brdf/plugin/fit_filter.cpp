@@ -91,10 +91,10 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "Where the per-vertex fit runs. Auto: a GLSL compute shader in MeshLab's OpenGL "
                            "context when it supports OpenGL 4.3, else the CPU (double precision). Both give "
                            "the same result to about 1e-3."));
-  params.addParam(RichFloat(kInitialShininess, vbrdf::PhongFitOptions().alpha_init, "Initial shininess",
+  params.addParam(RichFloat(kInitialShininess, vbrdf::kDefaultInitialShininess, "Initial shininess",
                             "Starting value of the Phong exponent alpha (the fit also tries an estimate from "
                             "the highlight samples and keeps the better one). Range [1, 2000]."));
-  params.addParam(RichEnum(kSpecularLobe, int(vbrdf::kFitLobe),
+  params.addParam(RichEnum(kSpecularLobe, int(vbrdf::kDefaultLobe),
                            QStringList() << "Phong on R.E (thesis)" << "Blinn-Phong on N.H" << "GGX on N.H",
                            "Specular lobe",
                            "The highlight's shape. Phong on R.E (the thesis): the cosine between the mirrored "
@@ -144,7 +144,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "normals and the PLY's nx ny nz become the refined ones (the relight filter and the "
                            "live view shade with them); the mesh's own normals are kept as mesh_nx/ny/nz. The "
                            "report says how far they moved. On by default."));
-  params.addParam(RichInt(kMaxIterations, vbrdf::PhongFitOptions().max_iterations, "Max iterations",
+  params.addParam(RichInt(kMaxIterations, vbrdf::kDefaultMaxIterations, "Max iterations",
                           "Cap on the shininess updates per vertex (each followed by an exact re-solve of "
                           "k_d, k_s and colour). Converged vertices stop earlier. 0: initial estimate only."));
   shared::add_min_specular_samples(params);

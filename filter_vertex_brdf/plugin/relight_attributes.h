@@ -9,8 +9,9 @@
 #include <vector>
 
 #include "core/fit/phong_fit.h"
-#include "core/samples/diffuse_form.h"
-#include "core/samples/lobe.h"
+#include "core/model/diffuse_form.h"
+#include "core/model/defaults.h"
+#include "core/model/lobe.h"
 #include "meshlab_bridge.h"
 
 namespace vbrdf_plugin {
@@ -18,7 +19,7 @@ namespace vbrdf_plugin {
 struct RelightModel {
   MeshArrays arrays;
   std::vector<vbrdf::VertexFit> fits;  // one per array vertex
-  vbrdf::LobeForm lobe = vbrdf::LobeForm::PhongRE;
+  vbrdf::LobeForm lobe = vbrdf::kDefaultLobe;
   vbrdf::DiffuseForms diffuse;  // per vertex where the fit made a coat map
   size_t modelled = 0;                 // vertices with fit_status != 0
 };

@@ -13,6 +13,7 @@
 #include "core/inputs/camera.h"
 #include "core/base/errors.h"
 #include "core/base/file_util.h"
+#include "core/base/number_format.h"
 #include "core/inputs/light_file.h"
 #include "core/inputs/light_source.h"
 #include "core/inputs/photo.h"
@@ -36,11 +37,6 @@ const char *const kSphereRadiusWorld = "sphereRadiusWorld";
 const char *const kPrefix = "Vertex BRDF sphere: ";
 const char *const kFitFilterName = "Vertex BRDF: fit per-vertex reflectance";
 
-std::string fmt(const char *format, double a, double b = 0, double c = 0, double d = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, format, a, b, c, d);
-  return buf;
-}
 
 std::vector<size_t> viewpoint_of(const std::vector<vbrdf::Raster> &rasters, size_t raster) {
   for (const std::vector<size_t> &group : vbrdf::rasters_by_viewpoint(rasters))
@@ -72,7 +68,7 @@ vbrdf::GrayLoader gray_loader(const std::vector<vbrdf::Raster> &rasters, const s
     const float fraction = std::min(0.95f, float(++*loads) / float(std::max<size_t>(1, expected)));
     if (progress && !progress(fraction, "finding the sphere and its highlights"))
       throw vbrdf::ProcessingError("cancelled");
-    const vbrdf::Photo photo = vbrdf::load_photo(r.image_path, p.encoding, 0.99f, r.width(), r.height());
+    const vbrdf::Photo photo = vbrdf::load_photo(r.image_path, p.encoding, vbrdf::kSaturationLevel, r.width(), r.height());
     return photo.pixels.depth() == CV_16U ? gray_of<uint16_t>(photo) : gray_of<uint8_t>(photo);
   };
 }
@@ -134,14 +130,14 @@ void log_positions(const vbrdf::LightCalibration &cal, const std::vector<vbrdf::
     const std::string name = "raster '" + r.label + "'";
     if (radius_world <= 0) {
       log(std::string(kPrefix) + name +
-          fmt(": near light at (%.3f, %.3f, %.3f) sphere radii in the camera frame (RMS miss %.3f); set "
+          vbrdf::formatted(": near light at (%.3f, %.3f, %.3f) sphere radii in the camera frame (RMS miss %.3f); set "
               "'sphereRadiusWorld' for world coordinates.",
               pl.position[0], pl.position[1], pl.position[2], pl.position_rms));
       continue;
     }
     const std::array<float, 3> w = world_position(pl, r);
     log(std::string(kPrefix) + name +
-        fmt(": near light at world (%.4f, %.4f, %.4f), RMS miss %.4f.", w[0], w[1], w[2], pl.position_rms));
+        vbrdf::formatted(": near light at world (%.4f, %.4f, %.4f), RMS miss %.4f.", w[0], w[1], w[2], pl.position_rms));
   }
 }
 
@@ -207,7 +203,7 @@ void write_positions(const vbrdf::LightCalibration &cal, const std::vector<vbrdf
   const std::string path = vbrdf::strip_extension(out_lp) + "_positions.json";
   vbrdf::write_light_positions(path, images, positions, rms);
   log(std::string(kPrefix) + "wrote the " + std::to_string(group.size()) + " triangulated light positions to '" +
-      path + "'" + fmt(" (the reflected rays miss them by %.4g median, %.4g at most, in mesh units). ",
+      path + "'" + vbrdf::formatted(" (the reflected rays miss them by %.4g median, %.4g at most, in mesh units). ",
                        sorted[sorted.size() / 2], sorted.back()) +
       "For near lights, set the fit's lightFile to it.");
 }

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "core/base/angles.h"
+
 namespace vbrdf_render {
 
 void draw_light_sphere(const std::array<float, 3> &c, float r, const std::vector<std::array<float, 3>> &photo_lights,
@@ -23,7 +25,7 @@ void draw_light_sphere(const std::array<float, 3> &c, float r, const std::vector
   for (int axis = 0; axis < 3; ++axis) {
     glBegin(GL_LINE_LOOP);
     for (int i = 0; i < 96; ++i) {
-      const float a = 2.0f * float(M_PI) * float(i) / 96.0f;
+      const float a = 2.0f * vbrdf::kPiF * float(i) / 96.0f;
       float p[3] = {0, 0, 0};
       p[(axis + 1) % 3] = r * std::cos(a);
       p[(axis + 2) % 3] = r * std::sin(a);

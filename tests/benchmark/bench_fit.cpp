@@ -28,6 +28,7 @@
 #include "osmesa_context.h"
 #include "fit/phong_fit.h"
 #include "fit/phong_fit_gpu.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -283,7 +284,7 @@ int main(int argc, char **argv) {
       head.vertex_count = uint32_t(warm.size());
       head.offsets.assign(chunk.offsets.begin(), chunk.offsets.begin() + long(warm.size()) + 1);
       head.samples.assign(chunk.samples.begin(), chunk.samples.begin() + long(head.offsets.back()));
-      gpu->fit_chunk(head, PhongFitOptions(), warm.data());
+      gpu->fit_chunk(head, vbrdf::test::thesis_fit_options(), warm.data());
       backends.push_back("gpu");
     } catch (const std::exception &e) {
       std::fprintf(stderr, "GPU back end unavailable: %s\n", e.what());
@@ -304,7 +305,7 @@ int main(int argc, char **argv) {
   std::vector<VertexFit> fits;
   for (const std::string &b : backends)
     for (int cap : a.caps) {
-      PhongFitOptions o;
+      PhongFitOptions o = vbrdf::test::thesis_fit_options();
       o.max_iterations = cap;
       Row r;
       r.backend = b;

@@ -27,6 +27,7 @@
 #include "run/fit_run.h"
 #include "inputs/project.h"
 #include "visibility/visibility_gl.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -120,7 +121,7 @@ int main(int argc, char **argv) {
       auto vis = make_backend(b, mesh, context);
       const VisibilityMasks masks = compute_visibility(mesh.view(), rasters, lights, *vis);
       const double t1 = now();
-      GatherSettings gs;
+      GatherSettings gs = vbrdf::test::thesis_gather_settings();
       PhotoCache cache(gs.encoding, gs.saturation_level, gs.photo_cache_bytes);
       std::vector<DiffuseEstimate> est(mesh.positions.size() / 3);
       const GatherStats stats = gather_samples(mesh.view(), rasters, lights, masks, gs, cache, [&](const SampleChunk &c) {

@@ -56,6 +56,7 @@
 #include "relight/relight_report.h"
 #include "io/result_ply.h"
 #include "visibility/visibility_gl.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -297,7 +298,7 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
                       const std::vector<LightSource> &training_lights, const GetProcAddressFn &get_proc, Json &out) {
   const HeldOut h = load_heldout(a, mesh);
   const auto t = Clock::now();
-  RelightRenderSettings render_settings;
+  RelightRenderSettings render_settings = vbrdf::test::thesis_render_settings();
   render_settings.lobe = lobe;
   render_settings.diffuse = diffuse;
   RelightRenderer renderer(mesh.view(), fits, get_proc, render_settings);
@@ -315,7 +316,7 @@ void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<Ver
   for (size_t r = 0; r < h.rasters.size(); ++r)
     rendered.push_back(render_as_photographed(renderer, h.rasters[r].shot, h.lights[r]));
   auto visibility = make_gl_visibility(mesh.view(), get_proc, VisibilitySettings());
-  RelightOptions ro;
+  RelightOptions ro = vbrdf::test::thesis_relight_options();
   ro.gather.lobe = lobe;  // the samples' lobe cosine and diffuse factor in the fit's forms
   ro.gather.diffuse = diffuse;
   ro.rendered = &rendered;

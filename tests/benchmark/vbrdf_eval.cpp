@@ -58,6 +58,7 @@
 #include "relight/relight_render.h"
 #include "io/result_ply.h"
 #include "visibility/visibility_gl.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -202,7 +203,7 @@ int main(int argc, char **argv) {
         light_placement_of(mesh_view, dome_radius, light_unit_scale);
     const Photos heldout = load_photos(mlp, lp, photo_dir, placement);
     Photos training;
-    RelightOptions options;
+    RelightOptions options = vbrdf::test::thesis_relight_options();
     options.gather.lobe = lobe;  // the samples' lobe cosine in the form the fit used
     options.gather.diffuse = diffuse;  // and their diffuse factor
     options.gather.footprint = footprint;
@@ -233,7 +234,7 @@ int main(int argc, char **argv) {
     std::unique_ptr<RelightRenderer> renderer;
     if (predict == "render") {
       if (!context) context.reset(new test::OsMesaContext());
-      RelightRenderSettings render_settings;
+      RelightRenderSettings render_settings = vbrdf::test::thesis_render_settings();
       render_settings.lobe = lobe;
       render_settings.diffuse = diffuse;
       renderer.reset(new RelightRenderer(result.mesh.view(), fits, context->get_proc_address(), render_settings));

@@ -20,6 +20,7 @@
 #include "io/output_ply.h"
 #include "inputs/project.h"
 #include "io/result_ply.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -59,7 +60,7 @@ void write_classes(const std::string &path, const MeshView &mesh, const Coverage
 
 int main(int argc, char **argv) {
   if (argc < 2) return usage();
-  CoverageSettings settings;
+  CoverageSettings settings = vbrdf::test::thesis_coverage_settings();
   std::string mlp, fit_path, classes_path;
   try {
     for (int i = 1; i < argc; ++i) {

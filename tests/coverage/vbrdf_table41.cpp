@@ -28,6 +28,7 @@
 #include "tools/mesh_io.h"
 #include "osmesa_context.h"
 #include "inputs/project.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -39,7 +40,7 @@ struct Options {
   float tolerance = 0, failure_cone = 20;
   bool brute = false, require_full = false, require_better_than_random = false, trace = false, both = false;
   double max_extra_vs_brute = -1;
-  CoverageSettings coverage;  // gather + visibility + suggestion settings
+  CoverageSettings coverage = vbrdf::test::thesis_coverage_settings();  // gather + visibility + suggestion settings
 };
 
 int usage() {

@@ -29,6 +29,7 @@
 #include "io/result_ply.h"
 #include "relight/live_view_file.h"
 #include "relight/relight_render.h"
+#include "thesis_settings.h"
 
 namespace {
 
@@ -121,7 +122,7 @@ int run(int argc, char **argv) {
     return 2;
   }
   const vbrdf::ResultPly result = vbrdf::read_result_ply(argv[1]);
-  vbrdf::RelightRenderSettings settings;
+  vbrdf::RelightRenderSettings settings = vbrdf::test::thesis_render_settings();
   const std::vector<vbrdf::VertexFit> fits = vbrdf::fits_from_result(result, argv[1], &settings.lobe, &settings.diffuse);
   const vbrdf::LiveViewRecord record = vbrdf::read_live_view(argv[2]);
   if (record.view.display != vbrdf::LiveDisplay::Full || std::fabs(record.view.projection[11]) < 1e-12) {

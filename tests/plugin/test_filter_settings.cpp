@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "core/base/errors.h"
+#include "core/relight/relight_render.h"
 #include "coverage_filter.h"
 #include "filter_parameters.h"
 #include "fit_filter.h"
@@ -59,6 +60,8 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
   EXPECT_EQ(s.overwrite, core.overwrite);  // on: replaced, and logged
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, core.gather.specular_threshold);
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, vbrdf::kFitDiffuseThreshold);
+  EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, core.gather.diffuse_threshold);
+  EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, vbrdf::GatherSettings().diffuse_threshold);
   EXPECT_EQ(s.gather.encoding, core.gather.encoding);
   EXPECT_FLOAT_EQ(s.gather.saturation_level, core.gather.saturation_level);
   EXPECT_EQ(s.gather.photo_cache_bytes, core.gather.photo_cache_bytes);
@@ -68,7 +71,11 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
   EXPECT_EQ(s.fit_reflectance, core.fit_reflectance);
   EXPECT_EQ(s.fit_backend, core.fit_backend);
   EXPECT_FLOAT_EQ(s.phong.alpha_init, core.phong.alpha_init);
-  EXPECT_EQ(s.phong.lobe, vbrdf::kFitLobe);
+  EXPECT_EQ(s.phong.lobe, vbrdf::kDefaultLobe);
+  EXPECT_EQ(s.phong.lobe, core.phong.lobe);
+  EXPECT_EQ(s.phong.lobe, vbrdf::PhongFitOptions().lobe);  // the core's structs on their own, too
+  EXPECT_EQ(s.phong.lobe, vbrdf::GatherSettings().lobe);
+  EXPECT_EQ(s.phong.lobe, vbrdf::RelightRenderSettings().lobe);
   EXPECT_EQ(s.diffuse_choice, vbrdf::kFitDiffuseChoice);
   EXPECT_EQ(s.phong.max_iterations, core.phong.max_iterations);
   EXPECT_EQ(s.phong.min_specular_samples, core.phong.min_specular_samples);
@@ -187,6 +194,7 @@ TEST(CoverageSettingsFrom, DefaultsAgreeWithTheFit) {
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, vbrdf::CoverageSettings().gather.diffuse_threshold);
   EXPECT_EQ(s.viewpoint_raster, -1);
   EXPECT_EQ(s.min_diffuse, vbrdf::CoverageSettings().min_diffuse);
+  EXPECT_EQ(s.min_specular, vbrdf::CoverageSettings().min_specular);
   EXPECT_FLOAT_EQ(s.poor_dq, vbrdf::CoverageSettings().poor_dq);
   EXPECT_FLOAT_EQ(s.poor_sq, vbrdf::CoverageSettings().poor_sq);
   EXPECT_FLOAT_EQ(s.suggest.min_elevation_deg, vbrdf::CoverageSettings().suggest.min_elevation_deg);

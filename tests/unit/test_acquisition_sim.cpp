@@ -11,6 +11,7 @@
 #include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -223,7 +224,7 @@ TEST(AcquisitionSim, GatheredCandidatesMatchTheCoverageCounts) {
   const MeshData mesh = load_mesh_ply(p.mesh_path);
   const auto lights = lights_for_rasters(p.rasters, find_default_light_file(p.rasters, p.project_path));
   auto vis = make_cpu_visibility(mesh.view(), VisibilitySettings());
-  const CandidateSet set = gather_candidates(mesh.view(), p.rasters, lights, *vis, GatherSettings());
+  const CandidateSet set = gather_candidates(mesh.view(), p.rasters, lights, *vis, vbrdf::test::thesis_gather_settings());
   ASSERT_EQ(set.size(), 16u);
   CoverageInput input;
   input.mesh = mesh.view();
@@ -269,7 +270,7 @@ TEST(AcquisitionSim, GatheredCandidatesMatchTheCoverageCounts) {
   auto vis2 = make_cpu_visibility(mesh2.view(), VisibilitySettings());
   const auto lights2 = lights_for_rasters(two.rasters, find_default_light_file(two.rasters, two.project_path));
   try {
-    gather_candidates(mesh2.view(), two.rasters, lights2, *vis2, GatherSettings());
+    gather_candidates(mesh2.view(), two.rasters, lights2, *vis2, vbrdf::test::thesis_gather_settings());
     ADD_FAILURE() << "two viewpoints accepted";
   } catch (const InputError &e) {
     EXPECT_NE(std::string(e.what()).find("one viewpoint"), std::string::npos);

@@ -15,6 +15,7 @@
 #include "test_scenes.h"
 #include "tools/relight.h"
 #include "visibility/visibility.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -212,7 +213,7 @@ TEST(Relight, DeconvolvedAlbedoIsPredictedThroughTheFootprint) {
     }
   const std::array<float, 3> light{{0, 1, 0}};
   auto visibility = make_cpu_visibility(g.mesh.view(), VisibilitySettings());
-  RelightOptions at_vertex;
+  RelightOptions at_vertex = vbrdf::test::thesis_relight_options();
   const RelightStats plain =
       evaluate_relighting(g.mesh.view(), fits, {raster}, {LightSource::directional(light)}, *visibility, at_vertex);
   const std::vector<uint8_t> deconvolved(g.vertex_count(), 1);

@@ -18,6 +18,7 @@
 #include "inputs/project.h"
 #include "test_paths.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -95,7 +96,7 @@ TEST(CoverageRun, ViewpointsGroupIdenticalShots) {
 
 TEST(CoverageRun, NeedsFromCountsAndFitQuality) {
   const std::vector<CoverageCounts> counts = {{0, 0, 0}, {3, 0, 0}, {3, 2, 0}, {3, 2, 1}, {3, 2, 1}};
-  CoverageSettings s;
+  CoverageSettings s = vbrdf::test::thesis_coverage_settings();
   CoverageNeeds n = coverage_needs(counts, nullptr, nullptr, s);
   EXPECT_EQ(n.diffuse, (std::vector<float>{0, 1, 0, 0, 0}));   // unseen: no light of this view helps
   EXPECT_EQ(n.specular, (std::vector<float>{0, 0, 1, 0, 0}));  // specular only once diffusely covered
@@ -165,7 +166,7 @@ TEST(LightFile, EveryFilterPicksTheSameFileBesideAStaleLightsLp) {
 
   CoverageInput cin = sample.input(rasters);
   cin.project_path = project;
-  EXPECT_EQ(run_on(cin, CoverageSettings(), dir).light_file, expected);
+  EXPECT_EQ(run_on(cin, vbrdf::test::thesis_coverage_settings(), dir).light_file, expected);
 
   FitInput fin;
   fin.mesh = sample.mesh.view();
@@ -200,7 +201,7 @@ TEST(CoverageRun, NewPhotosAndMergedLights) {
 TEST(CoverageRun, WholeRunOnTheSampleProject) {
   const SampleProject p;
   const std::string dir = test::scratch_dir("cov_run");
-  const CoverageResult r = run_on(p.input(p.project.rasters), CoverageSettings(), dir);
+  const CoverageResult r = run_on(p.input(p.project.rasters), vbrdf::test::thesis_coverage_settings(), dir);
   const size_t n = p.mesh.positions.size() / 3;
   size_t total = 0, unseen = 0;
   for (size_t c : r.class_counts) total += c;
@@ -240,11 +241,11 @@ TEST(CoverageRun, FollowingTheDiffuseSuggestionCoversWhatItPredicts) {
   const std::string dir = test::scratch_dir("cov_follow");
   std::vector<size_t> taken = {0};
   std::vector<Raster> rasters = {p.project.rasters[0]};
-  const CoverageResult one = run_on(p.input(rasters), CoverageSettings(), dir);  // a single photo works
+  const CoverageResult one = run_on(p.input(rasters), vbrdf::test::thesis_coverage_settings(), dir);  // a single photo works
   ASSERT_TRUE(one.diffuse.valid);
   const size_t next = nearest_raster(p.project.rasters, lights, taken, one.diffuse.dir_world);
   rasters.push_back(p.project.rasters[next]);
-  const CoverageResult two = run_on(p.input(rasters), CoverageSettings(), dir);
+  const CoverageResult two = run_on(p.input(rasters), vbrdf::test::thesis_coverage_settings(), dir);
   const size_t before = one.class_counts[kSeenNotDiffuse], after = two.class_counts[kSeenNotDiffuse];
   std::printf("seen but not diffusely covered: %zu -> %zu after raster %zu (suggestion covers %zu, light %.1f deg away)\n",
               before, after, next, one.diffuse.covered_vertices,
@@ -260,27 +261,27 @@ TEST(CoverageRun, PoorFitsAskForSamples) {
   const size_t n = input.mesh.vertex_count;
   input.dq.assign(n, 0.2f);
   input.sq.assign(n, 2.0f);
-  const CoverageResult r = run_on(input, CoverageSettings(), dir);
+  const CoverageResult r = run_on(input, vbrdf::test::thesis_coverage_settings(), dir);
   EXPECT_EQ(r.poor_diffuse, r.class_counts[kDiffuseNoSpecular] + r.class_counts[kFullyCovered]);
   EXPECT_EQ(r.poor_specular, 0u);
   EXPECT_TRUE(r.diffuse.valid);  // covered but poorly fitted vertices still get a diffuse light
   input.dq.resize(n - 1);
-  EXPECT_NE(error_of([&] { run_on(input, CoverageSettings(), dir); }).find("vertices"), std::string::npos);
+  EXPECT_NE(error_of([&] { run_on(input, vbrdf::test::thesis_coverage_settings(), dir); }).find("vertices"), std::string::npos);
 }
 
 TEST(CoverageRun, BadInputIsNamed) {
   const SampleProject p;
   const std::string dir = test::scratch_dir("cov_bad");
-  CoverageSettings s;
+  CoverageSettings s = vbrdf::test::thesis_coverage_settings();
   s.viewpoint_raster = 16;
   EXPECT_NE(error_of([&] { run_on(p.input(p.project.rasters), s, dir); }).find("Viewpoint raster 16"), std::string::npos);
-  s = CoverageSettings();
+  s = vbrdf::test::thesis_coverage_settings();
   write_text(dir + "/short.lp", "1\nimages/light_000.png 0 0 1\n");
   s.light_file = dir + "/short.lp";
   const std::string msg = error_of([&] { run_on(p.input(p.project.rasters), s, dir); });
   EXPECT_NE(msg.find("short.lp"), std::string::npos);
   EXPECT_NE(msg.find("light_001.png"), std::string::npos);
-  EXPECT_NE(error_of([&] { run_on(p.input({}), CoverageSettings(), dir); }).find("no rasters"), std::string::npos);
+  EXPECT_NE(error_of([&] { run_on(p.input({}), vbrdf::test::thesis_coverage_settings(), dir); }).find("no rasters"), std::string::npos);
 }
 
 // Algorithm 3 geometry: the specular light is the eye mirrored about the normal when that is

@@ -1,4 +1,4 @@
-// The diffuse term's form (samples/diffuse_form.h): the Fresnel transmission against known values,
+// The diffuse term's form (model/diffuse_form.h): the Fresnel transmission against known values,
 // the factor's normalisation, clamp and sign, and the gatherer storing it in Sample::d.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "fit/diffuse_choice.h"
-#include "samples/diffuse_form.h"
+#include "model/diffuse_form.h"
 
 namespace vbrdf {
 namespace {

@@ -7,8 +7,9 @@
 
 #include "fit/phong_fit.h"
 #include "samples/footprint.h"
-#include "samples/lobe.h"
+#include "model/lobe.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -133,7 +134,7 @@ TEST(PhongFit, RecoversTheSurfaceLobeThroughAFootprint) {
     s.footprint = 0;
     without.push_back(s);
   }
-  PhongFitOptions o;
+  PhongFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = LobeForm::GgxNH;
   o.alpha_max = 5000;
   VertexFit f_with, f_without;

@@ -19,6 +19,7 @@
 #include "relight/live_relight.h"
 #include "relight/relight_render.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 namespace vbrdf {
 namespace {
@@ -130,7 +131,7 @@ Agreement compare(const RelitImage &ref, const std::vector<float> &live, float e
 void check_forms(LobeForm lobe, const DiffuseForms &diffuse) {
   REQUIRE_GL(ctx);
   const Scene s = make_scene();
-  RelightRenderSettings settings;
+  RelightRenderSettings settings = vbrdf::test::thesis_render_settings();
   settings.lobe = lobe;
   settings.diffuse = diffuse;
   RelightRenderer reference(s.mesh.view(), s.fits, ctx->get_proc_address(), settings);

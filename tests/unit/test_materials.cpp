@@ -17,6 +17,7 @@
 
 #include "fit/materials.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -79,7 +80,7 @@ struct StageRun {
 };
 
 StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions(), LobeForm form = LobeForm::PhongRE) {
-  PhongFitOptions o;
+  PhongFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = form;
   StageRun r;
   r.before.resize(sc.chunk.vertex_count);
@@ -240,7 +241,7 @@ TEST(Materials, NoSamplesLeaveTheFitsAlone) {
   const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
   std::vector<VertexFit> fits(mesh.positions.size() / 3, VertexFit{{0, 0, 0}, 0, 0, 0, 0, 0, 0, 0, kFitNone, 0});
   MaterialSampleStore store(fits.size());
-  const MaterialResult r = fit_materials(mesh.view(), store, PhongFitOptions(), MaterialOptions(), nullptr, nullptr, fits);
+  const MaterialResult r = fit_materials(mesh.view(), store, vbrdf::test::thesis_fit_options(), MaterialOptions(), nullptr, nullptr, fits);
   EXPECT_EQ(r.chosen_k, 0);
   for (int32_t l : r.label) EXPECT_EQ(l, 0);
 }
@@ -250,7 +251,7 @@ TEST(Materials, NoSamplesLeaveTheFitsAlone) {
 // specular evidence: the stage keeps every vertex's own fit instead of stripping its lobe.
 TEST(Materials, WithoutAGlossyMaterialOwnLobesAreKept) {
   const Scene sc = make_scene(false, 0.0f, 30.0f, 5);  // a matte object
-  PhongFitOptions o;
+  PhongFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = LobeForm::GgxNH;
   std::vector<VertexFit> before(sc.chunk.vertex_count);
   fit_chunk_cpu(sc.chunk, o, before.data());

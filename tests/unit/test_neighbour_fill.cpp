@@ -10,6 +10,7 @@
 #include "fit/neighbour_fill.h"
 #include "fit/phong_fit.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 namespace vbrdf {
 namespace {
@@ -120,22 +121,22 @@ TEST(WeakFit, GrazingOrMixedOnlyVerticesStillGetAModel) {
   std::vector<Sample> grazing;
   for (float d : {0.1f, 0.2f, 0.3f, 0.4f}) grazing.push_back(lambert(d, kGrazing));
   VertexFit strict, weak;
-  fit_vertex_cpu(grazing.data(), grazing.size(), PhongFitOptions(), strict);
+  fit_vertex_cpu(grazing.data(), grazing.size(), vbrdf::test::thesis_fit_options(), strict);
   EXPECT_EQ(strict.status, kFitNone);  // T_d as a wall: no model
-  fit_vertex_weak(grazing.data(), grazing.size(), PhongFitOptions(), weak);
+  fit_vertex_weak(grazing.data(), grazing.size(), vbrdf::test::thesis_fit_options(), weak);
   ASSERT_EQ(weak.status, kFitFromWeakSamples);
   EXPECT_NEAR(weak.kd * weak.color[0], 0.6f, 0.02f);
   EXPECT_NEAR(weak.kd * weak.color[2], 0.2f, 0.02f);
 
   std::vector<Sample> mixed;
   for (float d : {0.6f, 0.8f, 1.0f}) mixed.push_back(lambert(d, kMixedPixel));
-  fit_vertex_weak(mixed.data(), mixed.size(), PhongFitOptions(), weak);
+  fit_vertex_weak(mixed.data(), mixed.size(), vbrdf::test::thesis_fit_options(), weak);
   ASSERT_EQ(weak.status, kFitFromWeakSamples);
   EXPECT_NEAR(weak.kd, 0.6f, 0.02f);
 
   // Nothing lit or everything clipped: still no model (the neighbour fill takes over).
   std::vector<Sample> dark = {lambert(0.5f, kCastShadow), lambert(0.7f, kSaturated)};
-  fit_vertex_weak(dark.data(), dark.size(), PhongFitOptions(), weak);
+  fit_vertex_weak(dark.data(), dark.size(), vbrdf::test::thesis_fit_options(), weak);
   EXPECT_EQ(weak.status, kFitNone);
   EXPECT_EQ(weak.kd, 0.0f);
 }

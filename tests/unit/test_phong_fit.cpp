@@ -5,6 +5,7 @@
 
 #include "fit/phong_fit.h"
 #include "phong_test_util.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 using test::TruePhong;
@@ -19,7 +20,7 @@ TEST(PhongFit, RecoversExactParametersWithoutNoise) {
   const TruePhong t{{0.5f, 0.3f, 0.1f}, 0.4f, 40.0f};
   const auto s = test::synth_samples(t, 40, 0.0f, rng);
   VertexFit f;
-  fit_vertex_cpu(s.data(), s.size(), PhongFitOptions(), f);
+  fit_vertex_cpu(s.data(), s.size(), vbrdf::test::thesis_fit_options(), f);
   EXPECT_EQ(f.status, kFitFull);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(rho_of(f, c), t.rho[c], 2e-3f);
   EXPECT_NEAR(f.ks, t.ks, 0.01f);
@@ -44,7 +45,7 @@ TEST(PhongFit, RecoveryOverWideRanges) {
     const float noise = 0.05f * u(rng);
     const auto s = test::synth_samples(t, n, noise, rng);
     VertexFit f;
-    fit_vertex_cpu(s.data(), s.size(), PhongFitOptions(), f);
+    fit_vertex_cpu(s.data(), s.size(), vbrdf::test::thesis_fit_options(), f);
     ASSERT_TRUE(std::isfinite(f.kd) && std::isfinite(f.ks) && std::isfinite(f.shininess));
     // Well-conditioned: enough samples and a visible specular term (or none at all).
     const bool well_posed = n >= 30 && (t.ks == 0 || t.ks > 0.1f) && t.alpha >= 2;
@@ -76,7 +77,7 @@ TEST(PhongFit, DiffuseHoleRemedy) {
   for (float d : ds) s.push_back(Sample{{0.4f * d, 0.4f * d, 0.4f * d}, d, 0.2f, 0, 0});
   s.push_back(Sample{{2.5f, 2.5f, 2.5f}, 0.97f, 0.995f, 0, kHighlight});
   s.push_back(Sample{{1.9f, 1.9f, 1.9f}, 0.96f, 0.93f, 0, kHighlight});
-  PhongFitOptions unchecked;
+  PhongFitOptions unchecked = vbrdf::test::thesis_fit_options();
   unchecked.specular_weight_cap = 1e9f;
   unchecked.diffuse_prior = 0;
   unchecked.min_specular_samples = 1;
@@ -85,7 +86,7 @@ TEST(PhongFit, DiffuseHoleRemedy) {
   VertexFit bad;
   fit_vertex_cpu(s.data(), s.size(), unchecked, bad);
   VertexFit good;
-  fit_vertex_cpu(s.data(), s.size(), PhongFitOptions(), good);
+  fit_vertex_cpu(s.data(), s.size(), vbrdf::test::thesis_fit_options(), good);
   std::printf("unchecked: kd %.3f ks %.3f alpha %.1f | ours: kd %.3f ks %.3f alpha %.1f\n", bad.kd, bad.ks,
               bad.shininess, good.kd, good.ks, good.shininess);
   EXPECT_LT(bad.kd, 0.2f);       // the failure exists without the remedies
@@ -97,7 +98,7 @@ TEST(PhongFit, TooFewHighlightsGiveDiffuseOnly) {
   std::vector<Sample> s = {{{0.3f, 0.2f, 0.1f}, 0.6f, 0.1f, 0, 0}, {{0.45f, 0.3f, 0.15f}, 0.9f, 0.3f, 0, 0},
                            {{0.9f, 0.9f, 0.9f}, 0.8f, 0.95f, 0, kHighlight}};
   VertexFit f;
-  fit_vertex_cpu(s.data(), s.size(), PhongFitOptions(), f);
+  fit_vertex_cpu(s.data(), s.size(), vbrdf::test::thesis_fit_options(), f);
   EXPECT_EQ(f.status, kFitDiffuseOnly);
   EXPECT_EQ(f.ks, 0.0f);
   EXPECT_EQ(f.shininess, 0.0f);

@@ -22,6 +22,7 @@
 #include "fit/phong_fit.h"
 #include "fit/phong_fit_gpu.h"
 #include "phong_test_util.h"
+#include "thesis_settings.h"
 
 namespace vbrdf {
 namespace {
@@ -308,7 +309,7 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuOnWellConditionedVertices) {
   std::mt19937 rng(7);
   SampleChunk chunk;
   for (int v = 0; v < 12000; ++v) append_vertex(chunk, random_vertex(rng));
-  const Agreement a = agree(chunk, PhongFitOptions(), "default options");
+  const Agreement a = agree(chunk, vbrdf::test::thesis_fit_options(), "default options");
   EXPECT_GT(a.well, 5000);
   EXPECT_EQ(a.well_disagree, 0);
   EXPECT_LE(a.posed_disagree, a.posed / 200);  // all of them where the reference itself is loose
@@ -318,14 +319,14 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuUnderOtherOptions) {
   std::mt19937 rng(8);
   SampleChunk chunk;
   for (int v = 0; v < 4000; ++v) append_vertex(chunk, random_vertex(rng));
-  PhongFitOptions no_remedies;
+  PhongFitOptions no_remedies = vbrdf::test::thesis_fit_options();
   no_remedies.diffuse_prior = 0;
   no_remedies.specular_weight_cap = 1e9f;
   no_remedies.min_specular_samples = 1;
-  PhongFitOptions capped;
+  PhongFitOptions capped = vbrdf::test::thesis_fit_options();
   capped.max_iterations = 2;
   capped.alpha_init = 50;
-  PhongFitOptions initial_only;
+  PhongFitOptions initial_only = vbrdf::test::thesis_fit_options();
   initial_only.max_iterations = 0;
   const struct {
     const PhongFitOptions *o;
@@ -348,11 +349,11 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
   std::uniform_int_distribution<int> code(0, 31);
   const SampleChunk chunk =
       random_chunk(rng, 4000, [&](int v, Sample &x) { x.resolution = uint16_t(v % 2 ? code(rng) : 0); });
-  PhongFitOptions half_angle;
+  PhongFitOptions half_angle = vbrdf::test::thesis_fit_options();
   half_angle.lobe = LobeForm::BlinnNH;
-  PhongFitOptions ggx;
+  PhongFitOptions ggx = vbrdf::test::thesis_fit_options();
   ggx.lobe = LobeForm::GgxNH;
-  PhongFitOptions mirror;  // R.E with resolution weights only
+  PhongFitOptions mirror = vbrdf::test::thesis_fit_options();  // R.E with resolution weights only
   for (const PhongFitOptions *o : {&half_angle, &ggx, &mirror}) {
     const Agreement a = agree(chunk, *o, (std::string(lobe_form_label(o->lobe)) + " lobe, resolution weights").c_str());
     EXPECT_GT(a.well, 1000);
@@ -372,7 +373,7 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
   const SampleChunk chunk = random_chunk(rng, 4000, [&](int v, Sample &x) {
     x.footprint = (v % 4 == 0 ? 0.0f : v % 4 == 1 ? 1e-3f : v % 4 == 2 ? 0.02f : 0.3f) * u(rng);
   });
-  PhongFitOptions ggx;
+  PhongFitOptions ggx = vbrdf::test::thesis_fit_options();
   ggx.lobe = LobeForm::GgxNH;
   const Agreement a = agree(chunk, ggx, "GGX lobe through pixel footprints");
   EXPECT_GT(a.well, 1000);
@@ -386,13 +387,13 @@ TEST_F(PhongFitGpuTest, TwoHundredFiftySixPhotoVertices) {
   std::mt19937 rng(9);
   SampleChunk chunk;
   for (int v = 0; v < 3000; ++v) append_vertex(chunk, random_vertex(rng, 256));
-  const Agreement a = agree(chunk, PhongFitOptions(), "256 samples per vertex");
+  const Agreement a = agree(chunk, vbrdf::test::thesis_fit_options(), "256 samples per vertex");
   EXPECT_GT(a.well, 2000);
   EXPECT_EQ(a.well_disagree, 0);
 }
 
 TEST_F(PhongFitGpuTest, DegenerateVerticesStayFiniteAndInBounds) {
-  const PhongFitOptions o;
+  const PhongFitOptions o = vbrdf::test::thesis_fit_options();
   const int sizes[] = {100000, 1000000};
   double last_secs = 0;
   const bool long_tests = std::getenv("VBRDF_LONG_TESTS") != nullptr;
@@ -435,7 +436,7 @@ TEST_F(PhongFitGpuTest, ExtremeMagnitudes) {
   SampleChunk tiny = base, huge = base;
   for (Sample &s : tiny.samples) for (float &c : s.rgb) c = std::ldexp(c, -100);
   for (Sample &s : huge.samples) for (float &c : s.rgb) c = std::ldexp(c, 100);
-  PhongFitOptions o;
+  PhongFitOptions o = vbrdf::test::thesis_fit_options();
   o.kd_max = o.ks_max = FLT_MAX;  // let the magnitudes through the clamps
   const Agreement a = agree(huge, o, "pixel values x 2^100", false, -100);
   EXPECT_GT(a.well, 1000);
@@ -474,7 +475,7 @@ TEST_F(PhongFitGpuTest, ContractCornerCases) {
   append_vertex(chunk, {{{0.18f, 0.18f, 0.18f}, 0.6f, 0.1f, 0, 0}, {{0.27f, 0.27f, 0.27f}, 0.9f, 0.3f, 0, 0},
                         {{0.15f, 0.15f, 0.15f}, 0.5f, 0.2f, 0, 0}, {{p + 1, p + 1, p + 1}, 0.9f, 1.0f, 0, kHighlight},
                         {{p + lobe, p + lobe, p + lobe}, 0.9f, 0.9995f, 0, kHighlight}});
-  PhongFitOptions o;
+  PhongFitOptions o = vbrdf::test::thesis_fit_options();
   o.alpha_init = 5000;
   const auto fits = run_gpu(chunk, o);
   for (const VertexFit &f : fits) EXPECT_TRUE(fit_in_bounds(f, o)) << "kd " << f.kd << " alpha " << f.shininess;
@@ -487,7 +488,7 @@ TEST_F(PhongFitGpuTest, BatchingGivesIdenticalResults) {
   std::mt19937 rng(11);
   SampleChunk chunk;
   for (int v = 0; v < 1000; ++v) append_vertex(chunk, random_vertex(rng, v == 500 ? 400 : 0));
-  const PhongFitOptions o;
+  const PhongFitOptions o = vbrdf::test::thesis_fit_options();
   const auto whole = run_gpu(chunk, o);
   EXPECT_EQ(gpu_->last_dispatch_count(), 1u);
   gpu_->set_batch_vertices(64);
@@ -506,12 +507,12 @@ TEST_F(PhongFitGpuTest, EmptyVerticesAndChunksGiveSentinels) {
   append_vertex(chunk, {});
   std::vector<VertexFit> out(3);
   std::memset(out.data(), 0xFF, out.size() * sizeof(VertexFit));
-  gpu_->fit_chunk(chunk, PhongFitOptions(), out.data());
+  gpu_->fit_chunk(chunk, vbrdf::test::thesis_fit_options(), out.data());
   const VertexFit none{{0, 0, 0}, 0, 0, 0, 0, 0, 0, 0, kFitNone, 0};
   EXPECT_EQ(std::memcmp(&out[0], &none, sizeof none), 0);
   EXPECT_EQ(std::memcmp(&out[2], &none, sizeof none), 0);
   EXPECT_NE(out[1].status, kFitNone);
-  gpu_->fit_chunk(SampleChunk(), PhongFitOptions(), nullptr);  // nothing to do
+  gpu_->fit_chunk(SampleChunk(), vbrdf::test::thesis_fit_options(), nullptr);  // nothing to do
 }
 
 TEST_F(PhongFitGpuTest, MalformedChunksThrow) {
@@ -522,16 +523,16 @@ TEST_F(PhongFitGpuTest, MalformedChunksThrow) {
   std::vector<VertexFit> out(2);
   SampleChunk past_end = chunk;
   past_end.offsets.back() += 5;
-  EXPECT_THROW(gpu_->fit_chunk(past_end, PhongFitOptions(), out.data()), ProcessingError);
+  EXPECT_THROW(gpu_->fit_chunk(past_end, vbrdf::test::thesis_fit_options(), out.data()), ProcessingError);
   SampleChunk decreasing = chunk;
   decreasing.offsets[1] = 15;
   decreasing.offsets[2] = 12;
   decreasing.samples.resize(12);
-  EXPECT_THROW(gpu_->fit_chunk(decreasing, PhongFitOptions(), out.data()), ProcessingError);
+  EXPECT_THROW(gpu_->fit_chunk(decreasing, vbrdf::test::thesis_fit_options(), out.data()), ProcessingError);
   SampleChunk short_offsets = chunk;
   short_offsets.offsets.pop_back();
-  EXPECT_THROW(gpu_->fit_chunk(short_offsets, PhongFitOptions(), out.data()), ProcessingError);
-  EXPECT_NO_THROW(gpu_->fit_chunk(chunk, PhongFitOptions(), out.data()));  // still usable
+  EXPECT_THROW(gpu_->fit_chunk(short_offsets, vbrdf::test::thesis_fit_options(), out.data()), ProcessingError);
+  EXPECT_NO_THROW(gpu_->fit_chunk(chunk, vbrdf::test::thesis_fit_options(), out.data()));  // still usable
 }
 
 TEST(PhongFitGpuCompatibility, RunsInACompatibilityContext) {
@@ -546,8 +547,8 @@ TEST(PhongFitGpuCompatibility, RunsInACompatibilityContext) {
   SampleChunk chunk;
   for (int v = 0; v < 500; ++v) append_vertex(chunk, random_vertex(rng));
   std::vector<VertexFit> g(chunk.vertex_count), c(chunk.vertex_count);
-  gpu.fit_chunk(chunk, PhongFitOptions(), g.data());
-  fit_chunk_cpu(chunk, PhongFitOptions(), c.data());
+  gpu.fit_chunk(chunk, vbrdf::test::thesis_fit_options(), g.data());
+  fit_chunk_cpu(chunk, vbrdf::test::thesis_fit_options(), c.data());
   int close = 0;
   for (uint32_t v = 0; v < chunk.vertex_count; ++v) close += g[v].status == c[v].status && parameter_difference(g[v], c[v]) < 1e-3;
   std::printf("%s: %d of %u vertices within 1e-3 of the CPU\n", context->version().c_str(), close, chunk.vertex_count);
@@ -569,7 +570,7 @@ TEST_F(PhongFitGpuTest, LeavesGlBindingsAsFound) {
   SampleChunk chunk;
   for (int v = 0; v < 100; ++v) append_vertex(chunk, random_vertex(rng));
   std::vector<VertexFit> out(chunk.vertex_count);
-  gpu_->fit_chunk(chunk, PhongFitOptions(), out.data());
+  gpu_->fit_chunk(chunk, vbrdf::test::thesis_fit_options(), out.data());
 
   GLint generic = -1, program = -1, bound[3] = {-1, -1, -1}, start = -1, size = -1;
   gl.GetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic);

@@ -6,6 +6,7 @@
 
 #include "fit/phong_fit.h"
 #include "phong_test_util.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -39,7 +40,7 @@ bool within(float v, float lo, float hi) { return std::isfinite(v) && v >= lo &&
 } // namespace
 
 TEST(PhongStress, MillionRandomAndDegenerateVertices) {
-  const PhongFitOptions o;
+  const PhongFitOptions o = vbrdf::test::thesis_fit_options();
   std::mt19937 rng(12345);
   const int n_vertices = 1000000;
   SampleChunk chunk;

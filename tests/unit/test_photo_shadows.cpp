@@ -5,6 +5,7 @@
 
 #include "fit/photo_shadows.h"
 #include "phong_test_util.h"
+#include "thesis_settings.h"
 
 namespace vbrdf {
 namespace {
@@ -42,7 +43,7 @@ float rho_error(const VertexFit &f) {
 TEST(PhotoShadows, DarkSamplesAreLeftOutAndTheVertexRefitted) {
   std::mt19937 rng(7);
   SampleChunk chunk = one_vertex(lit_samples(12, 3, rng));
-  const PhongFitOptions options;
+  const PhongFitOptions options = vbrdf::test::thesis_fit_options();
   VertexFit fit;
   fit_vertex_cpu(chunk.samples.data(), chunk.samples.size(), options, fit);
   const float before = rho_error(fit);
@@ -62,19 +63,19 @@ TEST(PhotoShadows, OffChangesNothing) {
   std::mt19937 rng(7);
   SampleChunk chunk = one_vertex(lit_samples(12, 3, rng));
   VertexFit fit;
-  fit_vertex_cpu(chunk.samples.data(), chunk.samples.size(), PhongFitOptions(), fit);
+  fit_vertex_cpu(chunk.samples.data(), chunk.samples.size(), vbrdf::test::thesis_fit_options(), fit);
   const VertexFit before = fit;
   PhotoShadowSettings off;
   off.enabled = false;
   size_t flagged = 0, refitted = 0;
-  refit_photo_shadows(chunk, PhongFitOptions(), off, &fit, flagged, refitted);
+  refit_photo_shadows(chunk, vbrdf::test::thesis_fit_options(), off, &fit, flagged, refitted);
   EXPECT_EQ(flagged + refitted, 0u);
   EXPECT_EQ(fit.kd, before.kd);
 }
 
 TEST(PhotoShadows, SafeguardsKeepMostSamplesAndEnoughOfThem) {
   std::mt19937 rng(11);
-  const PhongFitOptions options;
+  const PhongFitOptions options = vbrdf::test::thesis_fit_options();
   // More than half dark: the "shadow" is the vertex's own colour, nothing is flagged.
   std::vector<Sample> most_dark = lit_samples(12, 7, rng);
   VertexFit fit;
@@ -91,7 +92,7 @@ TEST(PhotoShadows, BrightAndFaintSamplesAreNotShadows) {
   std::mt19937 rng(3);
   std::vector<Sample> s = lit_samples(10, 0, rng);
   VertexFit fit;
-  fit_vertex_cpu(s.data(), s.size(), PhongFitOptions(), fit);
+  fit_vertex_cpu(s.data(), s.size(), vbrdf::test::thesis_fit_options(), fit);
   s[0].rgb[0] = s[0].rgb[1] = s[0].rgb[2] = 0.9f;  // a glint: brighter than the model, not a shadow
   for (float &c : s[1].rgb) c *= 0.05f;            // dark, but where the model predicts almost nothing:
   s[1].d = 0.01f;                                  //   below min_predicted, so no evidence either way

@@ -10,6 +10,7 @@
 #include "test_paths.h"
 #include "test_scenes.h"
 #include "visibility/visibility.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -89,7 +90,7 @@ TEST(Relight, UnmodelledVerticesCountAsBlackAndFilterRestricts) {
   EXPECT_EQ(s.seen_unmodelled_vertices, s.unmodelled_samples);  // one photo: one sample per vertex
   EXPECT_GE(s.seen_vertices, s.samples);
 
-  RelightOptions only_modelled;
+  RelightOptions only_modelled = vbrdf::test::thesis_relight_options();
   only_modelled.vertex_filter = &modelled;
   const RelightStats f = evaluate_relighting(scene.mesh.view(), fits, {scene.raster}, {LightSource::directional(scene.light)}, *visibility,
                                              only_modelled);
@@ -135,7 +136,7 @@ TEST(Relight, BaselinesScoreTheSameSamples) {
   const size_t n = scene.mesh.positions.size() / 3;
   std::vector<VertexFit> fits(n, diffuse_fit(rho));
   fits[0] = VertexFit{};  // one vertex without a model
-  RelightOptions options;
+  RelightOptions options = vbrdf::test::thesis_relight_options();
   options.training_rasters = &training;
   const std::vector<LightSource> training_sources = directional_lights(training_lights);
   options.training_lights = &training_sources;

@@ -21,6 +21,7 @@
 #include "relight/relight_report.h"
 #include "test_paths.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 namespace vbrdf {
 namespace {
@@ -79,7 +80,7 @@ struct PlaneCheck {
 // the column of triangles between x = -0.5 and 0 (grid spacing 0.5), which blend both forms, are
 // not checked.
 PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
-                        RelightRenderSettings settings = RelightRenderSettings(), bool coat_map = false) {
+                        RelightRenderSettings settings = vbrdf::test::thesis_render_settings(), bool coat_map = false) {
   const MeshData mesh = test::make_grid(8, 2.0f, 0.0f);
   if (coat_map) {
     auto coated = std::make_shared<std::vector<uint8_t>>(mesh.positions.size() / 3, 0);
@@ -136,7 +137,7 @@ TEST(RelightRender, PerPixelPhongMatchesTheModelEverywhere) {
 TEST(RelightRender, CoatedDiffuseMatchesTheModelEverywhere) {
   REQUIRE_GL(ctx);
   const LightSource low = LightSource::directional({{1.0f, 0.3f, 0.2f}});  // N.L about 0.28
-  RelightRenderSettings coated;
+  RelightRenderSettings coated = vbrdf::test::thesis_render_settings();
   coated.diffuse = DiffuseForms::everywhere(DiffuseForm::Coated);
   const PlaneCheck c = render_plane(*ctx, low, coated);
   EXPECT_GT(c.checked, 500u);
@@ -144,7 +145,7 @@ TEST(RelightRender, CoatedDiffuseMatchesTheModelEverywhere) {
   const PlaneCheck lambert = render_plane(*ctx, low);
   EXPECT_LT(lambert.worst, 2e-3);
   EXPECT_LT(c.brightest, 0.9 * lambert.brightest);  // T(0.28)/T(1) is about 0.78
-  const PlaneCheck map = render_plane(*ctx, low, RelightRenderSettings(), true);  // per vertex
+  const PlaneCheck map = render_plane(*ctx, low, vbrdf::test::thesis_render_settings(), true);  // per vertex
   EXPECT_GT(map.checked, 300u);
   EXPECT_LT(map.worst, 2e-3);
 }
@@ -155,12 +156,12 @@ TEST(RelightRender, CoatedDiffuseMatchesTheModelEverywhere) {
 TEST(RelightRender, GgxLobeMatchesTheModelEverywhere) {
   REQUIRE_GL(ctx);
   const LightSource light = LightSource::directional({{0.3f, 1.0f, 0.4f}});
-  RelightRenderSettings ggx;
+  RelightRenderSettings ggx = vbrdf::test::thesis_render_settings();
   ggx.lobe = LobeForm::GgxNH;
   const PlaneCheck c = render_plane(*ctx, light, ggx);
   EXPECT_GT(c.checked, 500u);
   EXPECT_LT(c.worst, 2e-3);
-  RelightRenderSettings blinn;
+  RelightRenderSettings blinn = vbrdf::test::thesis_render_settings();
   blinn.lobe = LobeForm::BlinnNH;
   EXPECT_LT(render_plane(*ctx, light, blinn).worst, 2e-3);
   EXPECT_GT(std::fabs(c.brightest - render_plane(*ctx, light, blinn).brightest) + std::fabs(c.darkest - render_plane(*ctx, light, blinn).darkest), 1e-3);
@@ -199,7 +200,7 @@ TEST(RelightRender, CastShadowsAndUnfittedVertices) {
     if (mesh.positions[3 * v] > 1.5f && mesh.positions[3 * v + 2] > 1.5f) fits[v] = VertexFit{};
   const float eye[3] = {0.0f, 6.0f, 0.01f}, target[3] = {0, 0, 0}, up[3] = {0, 0, -1};
   const Shot shot = test::make_look_at_shot(eye, target, up, 200, 320, 240);
-  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address());
+  RelightRenderer renderer(mesh.view(), fits, ctx->get_proc_address(), vbrdf::test::thesis_render_settings());
   const float s = std::sqrt(0.5f), light[3] = {s, s, 0};
   const RelitImage r = renderer.render(shot, LightSource::directional({{light[0], light[1], light[2]}}));
   auto class_at = [&](float x, float z) {
@@ -225,8 +226,8 @@ TEST(RelightRender, CastShadowsAndUnfittedVertices) {
 TEST(RelightRender, RejectsMismatchedFitsAndBadLights) {
   REQUIRE_GL(ctx);
   const MeshData mesh = test::make_grid(2, 1.0f, 0.0f);
-  EXPECT_THROW(RelightRenderer(mesh.view(), std::vector<VertexFit>(3), ctx->get_proc_address()), InputError);
-  RelightRenderer renderer(mesh.view(), std::vector<VertexFit>(9), ctx->get_proc_address());
+  EXPECT_THROW(RelightRenderer(mesh.view(), std::vector<VertexFit>(3), ctx->get_proc_address(), vbrdf::test::thesis_render_settings()), InputError);
+  RelightRenderer renderer(mesh.view(), std::vector<VertexFit>(9), ctx->get_proc_address(), vbrdf::test::thesis_render_settings());
   const float zero[3] = {0, 0, 0};
   EXPECT_THROW(renderer.render(top_camera(), LightSource::directional({{zero[0], zero[1], zero[2]}})), InputError);
   EXPECT_THROW(renderer.render(Shot(), LightSource::directional({{0, 1, 0}})), InputError);
@@ -261,7 +262,7 @@ TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
   const float rho[3] = {0.6f, 0.4f, 0.2f}, wrong[3] = {0.3f, 0.4f, 0.2f};
   std::vector<VertexFit> fits;
   FlatScene scene(rho, rho, fits);
-  RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address());
+  RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address(), vbrdf::test::thesis_render_settings());
   const RelightReport good = relight_rasters(renderer, {scene.raster}, {LightSource::directional(scene.light)}, RelightOutputOptions());
   ASSERT_EQ(good.rows.size(), 1u);
   const PixelComparison &c = good.rows[0].comparison;
@@ -287,7 +288,7 @@ TEST(RelightRender, ComparesLitVisiblePixelsWithThePhoto) {
 
   std::vector<VertexFit> wrong_fits;
   FlatScene other(rho, wrong, wrong_fits);
-  RelightRenderer wrong_renderer(other.mesh.view(), wrong_fits, ctx->get_proc_address());
+  RelightRenderer wrong_renderer(other.mesh.view(), wrong_fits, ctx->get_proc_address(), vbrdf::test::thesis_render_settings());
   const RelightReport bad = relight_rasters(wrong_renderer, {other.raster}, {LightSource::directional(other.light)}, RelightOutputOptions());
   const double expected = delta_e2000_linear_srgb(wrong, rho);
   EXPECT_NEAR(bad.rows[0].comparison.mean_de2000, expected, 0.05);
@@ -335,7 +336,7 @@ TEST(RelightRender, WritesImagesContactSheetAndTable) {
   const float rho[3] = {0.6f, 0.4f, 0.2f}, model[3] = {0.5f, 0.4f, 0.25f};
   std::vector<VertexFit> fits;
   FlatScene scene(rho, model, fits);
-  RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address());
+  RelightRenderer renderer(scene.mesh.view(), fits, ctx->get_proc_address(), vbrdf::test::thesis_render_settings());
   RelightOutputOptions options;
   options.folder = scene.dir + "/out/nested";
   Raster second = scene.raster;

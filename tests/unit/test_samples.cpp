@@ -8,6 +8,7 @@
 #include "samples/samples.h"
 #include "test_paths.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -15,7 +16,7 @@ namespace {
 struct Fixture {
   Raster raster;
   Photo photo;
-  GatherSettings settings;
+  GatherSettings settings = vbrdf::test::thesis_gather_settings();
   Fixture() {
     const float c[3] = {0, 0, 10}, t[3] = {0, 0, 0}, up[3] = {0, 1, 0};
     raster.shot = test::make_look_at_shot(c, t, up, 500, 64, 48);
@@ -138,7 +139,7 @@ TEST(Samples, GatherStreamsChunksInVertexOrder) {
   VisibilityMasks masks = all_seen(3000, 2);
   masks.lit[masks.words() + 0] = 0;  // raster 1: vertices 0..63 in cast shadow
   masks.seen[masks.words() + 1] = 0;  // raster 1 does not see vertices 64..127
-  GatherSettings settings;
+  GatherSettings settings = vbrdf::test::thesis_gather_settings();
   settings.chunk_sample_bytes = 1024 * sizeof(Sample) * 2;
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   uint32_t next = 0;
@@ -178,7 +179,7 @@ TEST(Samples, GatherSkipsVerticesNoPhotoSees) {
       for (size_t r = 0; r < 3; ++r) clear_bit(r, v);
     if (v % 5 == 0) clear_bit(1, v);  // photo 1 misses some more
   }
-  GatherSettings settings;
+  GatherSettings settings = vbrdf::test::thesis_gather_settings();
   settings.chunk_sample_bytes = 1100 * sizeof(Sample) * 3;  // chunks of 1100 vertices
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   size_t chunks = 0, unseen = 0, checked = 0;
@@ -227,7 +228,7 @@ TEST(Samples, GatherLeavesOutSamplesOffThePhotoThatTheMasksCallSeen) {
       directional_lights({{{0, 0, 1}}, {{0.6f, 0, 0.8f}}, {{0, 0.6f, 0.8f}}});
   VisibilityMasks masks = all_seen(n, 3);
   for (size_t v = 0; v < n; v += 11) masks.seen[masks.words() + v / 64] &= ~(uint64_t(1) << (v % 64));
-  GatherSettings settings;
+  GatherSettings settings = vbrdf::test::thesis_gather_settings();
   settings.chunk_sample_bytes = 1100 * sizeof(Sample) * 3;  // chunks of 1100 vertices
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   size_t stored = 0, dropped = 0, partly = 0;
@@ -385,7 +386,7 @@ TEST(Samples, GatherCodesEachSamplesResolutionAgainstTheVertexsBestPhoto) {
   const VisibilityMasks masks = all_seen(100, 3);
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   for (bool weights : {true, false}) {
-    GatherSettings settings;
+    GatherSettings settings = vbrdf::test::thesis_gather_settings();
     settings.resolution_weights = weights;
     int checked = 0;
     gather_samples(mesh.view(), rasters, directional_lights(lights), masks, settings, cache, [&](const SampleChunk &c) {
@@ -409,7 +410,7 @@ TEST(Samples, GatherTakesEachVertexsDiffuseForm) {
   PhotoCache cache(PhotoEncoding::Auto, 0.99f, 1 << 20);
   auto coated = std::make_shared<std::vector<uint8_t>>(100, 0);
   for (size_t v = 0; v < 100; v += 3) (*coated)[v] = 1;
-  GatherSettings settings;
+  GatherSettings settings = vbrdf::test::thesis_gather_settings();
   settings.diffuse = DiffuseForms{DiffuseForm::Lambert, coated};
   int checked = 0;
   gather_samples(mesh.view(), rasters, directional_lights(lights), masks, settings, cache, [&](const SampleChunk &c) {

@@ -14,6 +14,7 @@
 #include "fit/shading_normals.h"
 #include "samples/reshade.h"
 #include "test_scenes.h"
+#include "thesis_settings.h"
 
 using namespace vbrdf;
 
@@ -26,7 +27,7 @@ struct NormalCapture {
   std::vector<Raster> rasters;   // one per light, one camera
   std::vector<LightSource> lights;
   VertexFit model;
-  GatherSettings gather;
+  GatherSettings gather = vbrdf::test::thesis_gather_settings();
 };
 
 NormalCapture make_capture(size_t light_count = 24) {
@@ -99,7 +100,7 @@ SampleChunk gather(const NormalCapture &c) {
 }
 
 PhongFitOptions fit_options() {
-  PhongFitOptions o;
+  PhongFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = LobeForm::GgxNH;
   return o;
 }

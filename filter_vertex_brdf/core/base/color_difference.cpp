@@ -19,13 +19,11 @@ double lab_f(double t) {
   return t > d * d * d ? std::cbrt(t) : t / (3 * d * d) + 4.0 / 29.0;
 }
 
-double deg(double rad) { return rad * 180.0 / kPi; }
-double rad(double degrees) { return degrees * kPi / 180.0; }
 
 // Hue angle in degrees in [0, 360); 0 for a neutral colour (the formula's convention).
 double hue_deg(double b, double a) {
   if (a == 0 && b == 0) return 0;
-  const double h = deg(std::atan2(b, a));
+  const double h = degrees(std::atan2(b, a));
   return h < 0 ? h + 360 : h;
 }
 } // namespace
@@ -65,7 +63,7 @@ double ciede2000(const float lab1[3], const float lab2[3]) {
     if (dhp > 180) dhp -= 360;
     else if (dhp < -180) dhp += 360;
   }
-  const double dHp = 2 * std::sqrt(c1p * c2p) * std::sin(rad(dhp / 2));
+  const double dHp = 2 * std::sqrt(c1p * c2p) * std::sin(radians(dhp / 2));
 
   const double Lp_bar = 0.5 * (L1 + L2), Cp_bar = 0.5 * (c1p + c2p);
   double hp_bar = h1p + h2p;
@@ -74,8 +72,8 @@ double ciede2000(const float lab1[3], const float lab2[3]) {
     else if (h1p + h2p < 360) hp_bar = 0.5 * (h1p + h2p + 360);
     else hp_bar = 0.5 * (h1p + h2p - 360);
   }
-  const double t = 1 - 0.17 * std::cos(rad(hp_bar - 30)) + 0.24 * std::cos(rad(2 * hp_bar)) +
-                   0.32 * std::cos(rad(3 * hp_bar + 6)) - 0.20 * std::cos(rad(4 * hp_bar - 63));
+  const double t = 1 - 0.17 * std::cos(radians(hp_bar - 30)) + 0.24 * std::cos(radians(2 * hp_bar)) +
+                   0.32 * std::cos(radians(3 * hp_bar + 6)) - 0.20 * std::cos(radians(4 * hp_bar - 63));
   const double d_theta = 30 * std::exp(-std::pow((hp_bar - 275) / 25, 2));
   const double cp7 = std::pow(Cp_bar, 7);
   const double rc = 2 * std::sqrt(cp7 / (cp7 + p25));
@@ -83,7 +81,7 @@ double ciede2000(const float lab1[3], const float lab2[3]) {
   const double sl = 1 + 0.015 * l50 / std::sqrt(20 + l50);
   const double sc = 1 + 0.045 * Cp_bar;
   const double sh = 1 + 0.015 * Cp_bar * t;
-  const double rt = -std::sin(rad(2 * d_theta)) * rc;
+  const double rt = -std::sin(radians(2 * d_theta)) * rc;
   const double tl = dLp / sl, tc = dCp / sc, th = dHp / sh;
   return std::sqrt(std::max(0.0, tl * tl + tc * tc + th * th + rt * tc * th));
 }

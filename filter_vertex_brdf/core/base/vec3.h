@@ -1,5 +1,5 @@
 #pragma once
-// The small vocabulary of the core: 3-vectors, pi, and the number formats and timer of the reports;
+// The small vocabulary of the core: 3-vectors, pi (angles.h), the number formats (number_format.h) and the timer of the reports;
 // one definition instead of a copy per file. 3-vectors come in three forms, each where it fits:
 //  - plain float[3] / std::array<float, 3> at interfaces and in storage (the layout MeshView, the
 //    samples and the GL buffers use), with dot3 / cross3 / normalize3 below;
@@ -11,9 +11,10 @@
 #include <sstream>
 #include <string>
 
-namespace vbrdf {
+#include "base/angles.h"         // kPi
+#include "base/number_format.h"  // fixed, percent
 
-constexpr double kPi = 3.14159265358979323846;
+namespace vbrdf {
 
 template <typename T>
 inline T dot3(const T *a, const T *b) {
@@ -53,20 +54,6 @@ inline Vec3 normalized(Vec3 a) {
 }
 // v mirrored about the unit normal n: 2 (n.v) n - v (the thesis's R for v = L).
 inline Vec3 reflect_about(Vec3 v, Vec3 n) { return add(scale(n, 2 * dot(n, v)), scale(v, -1)); }
-
-// "1.23" for fixed(1.234, 2): the number format of the reports and logs.
-inline std::string fixed(double v, int digits = 2) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
-
-// "12.3%" for percent(123, 1000): shares in reports ("0%" when `whole` is 0).
-inline std::string percent(double part, double whole) {
-  return whole > 0 ? fixed(100.0 * part / whole, 1) + "%" : "0%";
-}
 
 // Seconds since `start` on the steady clock: the stage timings of the reports.
 using Clock = std::chrono::steady_clock;

@@ -10,8 +10,11 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/mcc.hpp>
 
+#include "base/clip_level.h"
 #include "base/color_difference.h"
 #include "base/errors.h"
+#include "base/number_format.h"
+#include "base/luminance.h"
 #include "inputs/photo.h"
 
 namespace vbrdf {
@@ -24,18 +27,11 @@ namespace {
 constexpr int kDetectSide = 2048;
 constexpr float kBoxW = 16.75f, kBoxH = 11.25f, kFirstCentre = 1.5f, kPitch = 2.75f;
 
-std::string fmt(const char *format, double a = 0, double b = 0, double c = 0, double d = 0) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, format, a, b, c, d);
-  return buf;
-}
 
 std::string photo_name(const std::vector<std::string> &names, size_t i) {
   if (i < names.size() && !names[i].empty()) return "'" + names[i] + "'";
   return "photo " + std::to_string(i + 1);
 }
-
-double luminance(const float c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -70,8 +66,8 @@ bool sample_rgb(const cv::Mat &img, double x, double y, cv::Vec3f &out) {
 bool neutral_row_reversed(const PatchMeasurement &m) {
   int forward = 0, backward = 0;
   for (int k = kFirstNeutralPatch; k + 1 < kChartPatches; ++k)
-    forward += luminance(m.rgb[k].data()) > luminance(m.rgb[k + 1].data());
-  for (int k = 5; k > 0; --k) backward += luminance(m.rgb[k].data()) > luminance(m.rgb[k - 1].data());
+    forward += luminance_double(m.rgb[k].data()) > luminance_double(m.rgb[k + 1].data());
+  for (int k = 5; k > 0; --k) backward += luminance_double(m.rgb[k].data()) > luminance_double(m.rgb[k - 1].data());
   return backward == 5 && forward < 4;
 }
 
@@ -144,7 +140,7 @@ void fit_tone_curve(const std::vector<int> &idx, const PatchColors &measured, co
                     ColorCorrection &out) {
   std::vector<double> xs, ys;
   for (int k : idx) {
-    const double x = luminance(measured[k].data()), y = luminance(reference[k].data());
+    const double x = luminance_double(measured[k].data()), y = luminance_double(reference[k].data());
     if (k >= kFirstNeutralPatch && x > 0 && y > 0) {
       xs.push_back(std::log(x));
       ys.push_back(std::log(y));
@@ -285,11 +281,11 @@ bool locate_chart(size_t count, const RgbLoader &load, const RgbLoader &detector
     if (quad_area(best[k]) > quad_area(best[pick])) pick = k;
   chart = best[pick];
   log.push_back("ColorChecker found by the mcc detector in " + photo_name(names, best_photo) + ": " +
-                fmt("corner patches at (%.1f, %.1f) and (%.1f, %.1f)", chart.corners[0].x, chart.corners[0].y,
+                formatted("corner patches at (%.1f, %.1f) and (%.1f, %.1f)", chart.corners[0].x, chart.corners[0].y,
                     chart.corners[2].x, chart.corners[2].y) +
-                fmt(", detector cost %.3f.", chart.cost));
+                formatted(", detector cost %.3f.", chart.cost));
   if (best.size() > 1)
-    log.push_back(fmt("Warning: %.0f charts found; using the larger one. Give the corner patches manually to "
+    log.push_back(formatted("Warning: %.0f charts found; using the larger one. Give the corner patches manually to "
                       "choose another.",
                       double(best.size())));
   return true;
@@ -317,7 +313,7 @@ PatchColors pooled_patches(const std::vector<PatchMeasurement> &patches, const s
     for (size_t p = 0; p < patches.size(); ++p)
       if (brightness[p] > 0 && patches[p].usable[k]) {
         photos.push_back(p);
-        lum.push_back(luminance(patches[p].rgb[k].data()) / brightness[p]);
+        lum.push_back(luminance_double(patches[p].rgb[k].data()) / brightness[p]);
       }
     usable[k] = !photos.empty();
     if (!usable[k]) continue;
@@ -391,7 +387,7 @@ std::vector<double> exposure_divisors(const std::vector<double> &b, const std::v
     const double e = std::sqrt(fit.g[0] * fit.g[0] + fit.g[1] * fit.g[1] + fit.g[2] * fit.g[2]);
     const double n[3] = {fit.g[0] / e, fit.g[1] / e, fit.g[2] / e};
     if (s.exposure == ExposureMode::Auto && fit.residual < s.constant_light_tolerance) {
-      log.push_back(fmt("Light intensity constant between photos: the chart's brightness follows its angle to "
+      log.push_back(formatted("Light intensity constant between photos: the chart's brightness follows its angle to "
                         "the light (residual %.1f %%); one exposure for all photos.",
                         100 * fit.residual));
       return std::vector<double>(b.size(), e);
@@ -408,7 +404,7 @@ std::vector<double> exposure_divisors(const std::vector<double> &b, const std::v
     for (double &v : d)
       if (v <= 0) v = emed;
     normalised = true;
-    log.push_back(fmt("Light intensity varies between photos (chart brightness departs from its angle to the light "
+    log.push_back(formatted("Light intensity varies between photos (chart brightness departs from its angle to the light "
                       "by %.1f %%, hand-held flash?): each photo's exposure is normalised by the chart's neutral "
                       "patches, with the chart normal fitted to the sphere lights.",
                       100 * fit.residual));
@@ -417,13 +413,13 @@ std::vector<double> exposure_divisors(const std::vector<double> &b, const std::v
   if (s.exposure == ExposureMode::On) {
     for (size_t p = 0; p < b.size(); ++p) d[p] = b[p] > 0 ? b[p] : bmed;
     normalised = true;
-    log.push_back(fmt("Exposure normalisation on: each photo is normalised by the chart's neutral patches (their "
+    log.push_back(formatted("Exposure normalisation on: each photo is normalised by the chart's neutral patches (their "
                       "brightness varies by up to %.1f %%; without light directions this includes the chart's angle "
                       "to the light).",
                       100 * spread));
     return d;
   }
-  log.push_back(fmt("Chart brightness varies by up to %.1f %% between photos; without light directions this cannot "
+  log.push_back(formatted("Chart brightness varies by up to %.1f %% between photos; without light directions this cannot "
                     "be told from the chart's angle to the light, so photos are not normalised (turn exposure "
                     "normalisation on for a light of varying intensity).",
                     100 * spread));
@@ -570,7 +566,7 @@ ChartLocation refine_chart(const cv::Mat &bgr8, const ChartLocation &coarse, cv:
   std::vector<std::string> lines;
   std::vector<ChartLocation> found = detect_charts_at_full_size(bgr8(window).clone(), 1, lines);
   if (found.empty()) {
-    log.push_back(fmt("ColorChecker: located at 1/%.0f of the photo's size only (not found again at full size).", factor));
+    log.push_back(formatted("ColorChecker: located at 1/%.0f of the photo's size only (not found again at full size).", factor));
     return scaled;
   }
   ChartLocation fine = found.front();
@@ -635,8 +631,8 @@ PatchMeasurement measure_chart_at(const cv::Mat &img, const ChartLocation &chart
           inside = false;
           break;
         }
-        clipped += v[0] >= 0.995f || v[1] >= 0.995f || v[2] >= 0.995f;
-        s.emplace_back(0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2], v);
+        clipped += v[0] >= kClippedLinearValue || v[1] >= kClippedLinearValue || v[2] >= kClippedLinearValue;
+        s.emplace_back(luminance_double(&v[0]), v);
       }
     if (!inside) continue;
     // Trimmed mean: specks of dust, a glint or the patch edge do not move it.
@@ -649,7 +645,7 @@ PatchMeasurement measure_chart_at(const cv::Mat &img, const ChartLocation &chart
     sum /= double(hi - lo);
     for (int c = 0; c < 3; ++c) m.rgb[k][c] = float(sum[c]);
     m.clipped[k] = float(clipped) / float(s.size());
-    m.usable[k] = m.clipped[k] < 0.02f && luminance(m.rgb[k].data()) > 1e-3;
+    m.usable[k] = m.clipped[k] < 0.02f && luminance_double(m.rgb[k].data()) > 1e-3;
   }
   return m;
 }
@@ -689,8 +685,8 @@ void ColorCorrection::apply(const float in_raw[3], float out[3]) const {
 double neutral_scale(const PatchColors &measured, const PatchColors &reference, const PatchFlags &usable) {
   std::vector<double> ratios;
   for (int k = kFirstNeutralPatch; k < kChartPatches; ++k) {
-    const double y = luminance(measured[k].data());
-    if (usable[k] && y > 0) ratios.push_back(luminance(reference[k].data()) / y);
+    const double y = luminance_double(measured[k].data());
+    if (usable[k] && y > 0) ratios.push_back(luminance_double(reference[k].data()) / y);
   }
   return median_of(ratios);
 }
@@ -705,7 +701,7 @@ CorrectionFit fit_color_correction(const PatchColors &measured, const PatchColor
       neutrals += k >= kFirstNeutralPatch;
     }
   if (idx.size() < 8 || neutrals < 3)
-    throw ProcessingError(fmt("Colour correction: only %.0f usable chart patches (%.0f neutral); at least 8 with "
+    throw ProcessingError(formatted("Colour correction: only %.0f usable chart patches (%.0f neutral); at least 8 with "
                               "3 neutral are needed. Check the chart's exposure (no clipped white) and position.",
                               double(idx.size()), double(neutrals)));
   CorrectionFit f;
@@ -773,12 +769,12 @@ ColorCalibration calibrate_colors(size_t count, const RgbLoader &load, const Col
   }
   cal.correction = cal.fit.best;
   cal.corrected = true;
-  cal.log.push_back(fmt("Colour correction: %.0f patches; held-out CIEDE2000 %.2f (3x3 matrix), %.2f (tone curve + "
+  cal.log.push_back(formatted("Colour correction: %.0f patches; held-out CIEDE2000 %.2f (3x3 matrix), %.2f (tone curve + "
                         "matrix), %.2f (per-channel polynomial): ",
                         cal.fit.patches, cal.fit.heldout_matrix, cal.fit.heldout_curve_matrix,
                         cal.fit.heldout_polynomial) +
                     correction_model_name(cal.correction.model) +
-                    fmt(" chosen. Patch CIEDE2000 mean %.2f (max %.2f) before, %.2f (max %.2f) after.", cal.fit.before,
+                    formatted(" chosen. Patch CIEDE2000 mean %.2f (max %.2f) before, %.2f (max %.2f) after.", cal.fit.before,
                         cal.fit.before_max, cal.fit.after, cal.fit.after_max));
   cal.divisor = exposure_divisors(b, lights, s, cal.exposure_normalised, cal.log);
   return cal;

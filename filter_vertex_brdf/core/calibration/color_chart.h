@@ -68,7 +68,7 @@ cv::Mat linear_rgb_image(const cv::Mat &image, bool bgr, bool decode_srgb = true
 
 struct PatchMeasurement {
   PatchColors rgb{};          // linear RGB: trimmed mean of the patch's central area
-  std::array<float, kChartPatches> clipped{};  // fraction of clipped samples (a channel >= 0.995)
+  std::array<float, kChartPatches> clipped{};  // fraction of clipped samples (a channel >= kClippedLinearValue)
   PatchFlags usable{};        // inside the photo, not clipped, above the noise floor
 };
 

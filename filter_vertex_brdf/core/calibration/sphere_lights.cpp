@@ -8,7 +8,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "base/clip_level.h"
 #include "base/errors.h"
+#include "base/number_format.h"
 #include "inputs/photo.h"
 #include "base/vec3.h"
 
@@ -69,11 +71,6 @@ constexpr double kCircleCheckMinOffsetPx = 3.0;
 constexpr double kCircleCheckOffsetRadii = 0.03;
 
 
-std::string fmt(const char *format, double a = 0, double b = 0, double c = 0, double d = 0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, format, a, b, c, d);
-  return buf;
-}
 
 std::string photo_name(const std::vector<std::string> &names, size_t i) {
   if (i < names.size() && !names[i].empty()) return "'" + names[i] + "'";
@@ -613,7 +610,7 @@ double angle_deg(const double a[3], const double b[3]) {
   double cr[3];
   cross3(a, b, cr);
   // atan2 keeps precision for small angles, where acos does not.
-  return std::atan2(std::sqrt(dot3(cr, cr)), dot3(a, b)) * 180.0 / kPi;
+  return degrees(std::atan2(std::sqrt(dot3(cr, cr)), dot3(a, b)));
 }
 
 cv::Mat gray_image(const cv::Mat &image, bool decode_srgb) {
@@ -663,13 +660,13 @@ Highlight find_highlight(const cv::Mat &gray, const SphereCircle &c, const Highl
   h.peak = peak;
   h.background = masked_median(roi, mask);
   if (peak < s.min_peak) {
-    h.problem = fmt("no highlight: the brightest point of the sphere is %.2f of full scale (sphere in shadow, "
+    h.problem = formatted("no highlight: the brightest point of the sphere is %.2f of full scale (sphere in shadow, "
                     "or the light is behind it)",
                     peak);
     return h;
   }
   if (peak - h.background < s.min_contrast) {
-    h.problem = fmt("no distinct highlight: brightest %.2f, sphere median %.2f (sphere in shadow or overexposed)",
+    h.problem = formatted("no distinct highlight: brightest %.2f, sphere median %.2f (sphere in shadow or overexposed)",
                     peak, h.background);
     return h;
   }
@@ -726,7 +723,7 @@ Highlight find_highlight(const cv::Mat &gray, const SphereCircle &c, const Highl
       ux += px;
       uy += py;
       ++area;
-      saturated = saturated || r[x] >= 0.995f;
+      saturated = saturated || r[x] >= kClippedLinearValue;
     }
   }
   h.found = true;
@@ -1006,8 +1003,8 @@ DetectedSphere detected_sphere(const Candidate &c, const cv::Mat &fine, const Sp
   d.method = c.hough ? SphereMethod::Hough : SphereMethod::HighlightTrack;
   d.edge_score = c.score;
   d.highlights_inside = c.support;
-  d.description = fmt("centre (%.2f, %.2f), radius %.2f px", d.model.circle.x, d.model.circle.y, d.model.circle.r) +
-                  fmt(", outline contrast %.2f, a bright spot inside in %.0f of %.0f photos", c.score, c.support,
+  d.description = formatted("centre (%.2f, %.2f), radius %.2f px", d.model.circle.x, d.model.circle.y, d.model.circle.r) +
+                  formatted(", outline contrast %.2f, a bright spot inside in %.0f of %.0f photos", c.score, c.support,
                       double(count)) +
                   "; found by " + join(c.sources);
   return d;
@@ -1039,7 +1036,7 @@ std::vector<DetectedSphere> detect_spheres(size_t count, const GrayLoader &load,
     if (!refine_and_score(c, edges_max, edges_med, cam, summary.spots, min_r, max_r, search.min_edge_score)) continue;
     const SphereCircle &cc = c.model.circle;
     if (!circle_inside(cc, summary.width, summary.height, kBorderTolerancePx)) {
-      log.push_back(fmt("Sphere candidate at (%.1f, %.1f), radius %.1f px rejected: the image border cuts it. "
+      log.push_back(formatted("Sphere candidate at (%.1f, %.1f), radius %.1f px rejected: the image border cuts it. "
                         "Move the sphere fully into the frame, or set its centre and radius manually.",
                         cc.x, cc.y, cc.r));
       continue;
@@ -1113,7 +1110,7 @@ void locate_spheres(size_t count, const GrayLoader &load, const SphereCamera &ca
       if (!(d.model.circle.r > 0))
         throw InputError("Sphere " + std::to_string(k + 1) + ": the manual circle is not in front of the camera");
       d.method = SphereMethod::Manual;
-      d.description = fmt("centre (%.2f, %.2f), radius %.2f px", c.x, c.y, c.r) + "; given by the user";
+      d.description = formatted("centre (%.2f, %.2f), radius %.2f px", c.x, c.y, c.r) + "; given by the user";
       cal.spheres.push_back(d);
     }
   } else {
@@ -1165,7 +1162,7 @@ void reject_shadowed_highlights(LightCalibration &cal) {
       Highlight &h = pl.spheres[k].highlight;
       if (h.found && h.peak < 0.3 * median_peak) {
         h.found = false;
-        h.problem = fmt("no highlight: the brightest point (%.2f) is far below this sphere's usual highlight "
+        h.problem = formatted("no highlight: the brightest point (%.2f) is far below this sphere's usual highlight "
                         "(%.2f): sphere in shadow?",
                         h.peak, median_peak);
       }
@@ -1232,11 +1229,11 @@ void summarise_lights(size_t count, const SphereCamera &cam, const LightSettings
                     " photos got a light direction.");
   if (!disagreements.empty()) {
     std::sort(disagreements.begin(), disagreements.end());
-    cal.log.push_back(fmt("Angular disagreement between the spheres: median %.2f deg, max %.2f deg over %.0f photos.",
-                          disagreements[disagreements.size() / 2], disagreements.back(), double(disagreements.size())));
+    cal.log.push_back(formatted("Angular disagreement between the spheres: median %.2f deg, max %.2f deg over %.0f photos.",
+                                disagreements[disagreements.size() / 2], disagreements.back(), double(disagreements.size())));
   }
   if (positions > 0)
-    cal.log.push_back(fmt("Near-light positions triangulated for %.0f photos (camera frame, ", double(positions)) +
+    cal.log.push_back(formatted("Near-light positions triangulated for %.0f photos (camera frame, ", double(positions)) +
                       (cam.perspective ? (settings.sphere_radius_world > 0 ? "world units" : "units of the sphere radius")
                                        : "pixels") +
                       ").");
@@ -1303,12 +1300,12 @@ CircleCheck check_sphere_circle(size_t count, const GrayLoader &load, const Sphe
   out.offset_px = std::max(std::hypot(out.refined.x - circle.x, out.refined.y - circle.y),
                            std::fabs(out.refined.r - circle.r));
   const bool on_outline = out.offset_px <= std::max(kCircleCheckMinOffsetPx, kCircleCheckOffsetRadii * circle.r);
-  out.description = fmt("circle (%.1f, %.1f) r %.1f px: outline visible on %.0f %% of its length", circle.x, circle.y,
+  out.description = formatted("circle (%.1f, %.1f) r %.1f px: outline visible on %.0f %% of its length", circle.x, circle.y,
                         circle.r, 100.0 * out.outline_coverage) +
                     ", bright spot inside in " + std::to_string(out.spots_inside) + " of " +
                     std::to_string(out.photos_with_spot) + " photos with one" +
-                    fmt(", strongest outline nearby at (%.1f, %.1f) r %.1f px", out.refined.x, out.refined.y,
-                        out.refined.r) + fmt(" (%.1f px away)", out.offset_px);
+                    formatted(", strongest outline nearby at (%.1f, %.1f) r %.1f px", out.refined.x, out.refined.y,
+                        out.refined.r) + formatted(" (%.1f px away)", out.offset_px);
   out.plausible = out.plausible && on_outline;
   out.description += out.plausible ? ": a sphere" : ": NOT this sphere's outline in these photos";
   return out;

@@ -113,7 +113,7 @@ struct Highlight {
   double background = 0;   // median of the search disc
   double threshold = 0;    // final blob threshold
   int area = 0;            // blob area in pixels at that threshold
-  bool saturated = false;  // the blob contains clipped pixels (>= 0.995 of full scale)
+  bool saturated = false;  // the blob contains clipped pixels (>= kClippedLinearValue of full scale)
   std::string problem;     // why no highlight was found (empty when found)
 };
 

@@ -1,4 +1,5 @@
 #include "coverage/coverage.h"
+#include "base/directions.h"
 #include "base/vec3.h"
 
 #include <algorithm>
@@ -11,8 +12,7 @@
 namespace vbrdf {
 
 namespace {
-constexpr float kPiF = float(kPi);  // float maths here
-constexpr float kDeg = kPiF / 180.0f;
+constexpr float kDeg = kRadiansPerDegreeF;  // float maths here
 
 // Camera axes in world coordinates (rows of the shot rotation).
 Vec3 camera_axis(const Shot &shot, int row) {
@@ -76,19 +76,6 @@ bool ideal_light(CoverageKind kind, Vec3 n, Vec3 e, const Shot &viewpoint, const
   return make_placeable(l, n, e, cam_z, kind, s);
 }
 
-// Octahedral index of a unit vector on a res x res grid.
-int octa_cell(Vec3 n, int res) {
-  const float a = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
-  float u = n.x / a, v = n.y / a;
-  if (n.z < 0) {
-    const float nu = (1 - std::fabs(v)) * (u >= 0 ? 1 : -1), nv = (1 - std::fabs(u)) * (v >= 0 ? 1 : -1);
-    u = nu, v = nv;
-  }
-  const int i = std::min(res - 1, std::max(0, int((u * 0.5f + 0.5f) * res)));
-  const int j = std::min(res - 1, std::max(0, int((v * 0.5f + 0.5f) * res)));
-  return j * res + i;
-}
-
 // Vertices sharing quantised normal and image tile (hence eye direction) behave alike.
 struct Group {
   float n[3] = {0, 0, 0}, e[3] = {0, 0, 0};
@@ -120,11 +107,12 @@ std::vector<Group> group_vertices(const MeshView &mesh, const Shot &viewpoint, c
       if (!visible[v] || !(needs[v] > 0)) continue;
       const float *p = mesh.positions + 3 * v;
       const Vec3 n = normalized(vec3_of(mesh.normals + 3 * v));
+      const float n_cell[3] = {n.x, n.y, n.z};
       const Vec3 e = eye_direction(viewpoint, p);
       const ImagePoint ip = project_to_image(viewpoint, p);
       const int tx = std::min(kTiles - 1, std::max(0, int(ip.x / w * kTiles)));
       const int ty = std::min(kTiles - 1, std::max(0, int(ip.y / h * kTiles)));
-      Group &g = mine[size_t(octa_cell(n, kNormalRes)) * kTiles * kTiles + size_t(ty * kTiles + tx)];
+      Group &g = mine[size_t(octahedral_cell(n_cell, kNormalRes)) * kTiles * kTiles + size_t(ty * kTiles + tx)];
       g.n[0] += n.x, g.n[1] += n.y, g.n[2] += n.z;
       g.e[0] += e.x, g.e[1] += e.y, g.e[2] += e.z;
       g.weight += needs[v];

@@ -36,8 +36,8 @@ void count_coverage_chunk(const SampleChunk &chunk, CoverageCounts *out);
 CoverageClass classify_coverage(const CoverageCounts &c, int min_diffuse = 1, int min_specular = 1);
 
 struct LightSuggestionSettings {
-  float specular_threshold = 0.9f;  // T_s
-  float diffuse_threshold = 0.5f;   // T_d
+  float specular_threshold = kDefaultSpecularThreshold;  // T_s
+  float diffuse_threshold = kCoverageDiffuseThreshold;   // T_d
   int bins = 36;                    // latitude and longitude divisions (thesis: 36)
   float min_elevation_deg = 5.0f;   // lights must be at least this far above the camera's image plane
   float margin_deg = 2.0f;          // aim this far inside a threshold (thesis: "a small amount")

@@ -7,18 +7,25 @@
 #include "base/output_file.h"
 #include "coverage/coverage.h"
 #include "fit/fit_backends.h"  // VisibilityChoice
+#include "model/defaults.h"
 #include "samples/samples.h"
 #include "visibility/visibility.h"
 
 namespace vbrdf {
 
 struct CoverageSettings {
+  // Coverage asks for well-lit samples (T_d kCoverageDiffuseThreshold) and counts highlights on R.E
+  // (kHighlight): it fits no lobe, so its samples take the R.E cosine and no footprints.
+  CoverageSettings() {
+    gather.diffuse_threshold = kCoverageDiffuseThreshold;
+    gather.lobe = LobeForm::PhongRE;
+  }
   GatherSettings gather;            // T_s and T_d classify samples and drive the suggestions
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;
   LightSuggestionSettings suggest;  // its thresholds are replaced by gather's
   int min_diffuse = 1;              // diffuse samples a vertex needs to count as diffusely covered
-  int min_specular = 1;             // specular samples it needs to count as specularly covered
+  int min_specular = kDefaultMinSpecularSamples;  // specular samples it needs to count as specularly covered
   int viewpoint_raster = -1;        // suggestions for the viewpoint of this raster; -1: the last raster
   // With a fit (CoverageInput::dq/sq): a covered vertex whose DQ (SQ) is below this still needs
   // diffuse (specular) samples, weighted (poor - q) / poor; uncovered vertices weigh 1.

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "base/directions.h"
 #include "base/vec3.h"
 #include "coverage/coverage_geometry.h"
 
@@ -19,7 +20,7 @@ namespace {
 // sufficient cases first (the normal, the mirror direction), else Algorithm 1/3's search.
 bool coverable(CoverageKind kind, const float *n, const float *e, const Shot &viewpoint, const float cam_z[3],
                const LightSuggestionSettings &s) {
-  const float zmin = std::sin(s.min_elevation_deg * kPi / 180);
+  const float zmin = std::sin(radians(s.min_elevation_deg));
   // Largest cosine between `v` and a placeable direction (the cap z >= zmin around cam_z).
   const auto best_cos = [&](const float *v) {
     const float theta = std::acos(std::max(-1.0f, std::min(1.0f, dot3(v, cam_z)))), edge = std::acos(zmin);
@@ -43,20 +44,6 @@ bool coverable(CoverageKind kind, const float *n, const float *e, const Shot &vi
 void camera_axis_z(const Shot &shot, float out[3]) {
   const float towards_viewer[3] = {0, 0, 1};
   camera_to_world_direction(shot, towards_viewer, out);
-}
-
-// Octahedral cell of a unit vector on a res x res grid.
-int octa_cell(const float n[3], int res) {
-  const float a = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
-  if (!(a > 0)) return 0;
-  float u = n[0] / a, v = n[1] / a;
-  if (n[2] < 0) {
-    const float nu = (1 - std::fabs(v)) * (u >= 0 ? 1 : -1), nv = (1 - std::fabs(u)) * (v >= 0 ? 1 : -1);
-    u = nu, v = nv;
-  }
-  const int i = std::min(res - 1, std::max(0, int((u * 0.5f + 0.5f) * float(res))));
-  const int j = std::min(res - 1, std::max(0, int((v * 0.5f + 0.5f) * float(res))));
-  return j * res + i;
 }
 
 } // namespace
@@ -100,7 +87,7 @@ bool new_view_hint(const MeshView &mesh, const std::vector<uint32_t> &vertices, 
   std::vector<std::array<double, 4>> cells(size_t(kRes) * kRes, std::array<double, 4>{{0, 0, 0, 0}});
   for (uint32_t v : vertices) {
     const float *n = mesh.normals + 3 * size_t(v);
-    auto &c = cells[size_t(octa_cell(n, kRes))];
+    auto &c = cells[size_t(octahedral_cell(n, kRes))];
     c[0] += n[0], c[1] += n[1], c[2] += n[2], c[3] += 1;
   }
   std::vector<std::array<float, 4>> groups;  // mean normal, count
@@ -110,10 +97,9 @@ bool new_view_hint(const MeshView &mesh, const std::vector<uint32_t> &vertices, 
       if (l > 0) groups.push_back({{float(c[0] / l), float(c[1] / l), float(c[2] / l), float(c[3])}});
     }
   double best = 0;
-  for (int i = 0; i < kCandidates; ++i) {  // Fibonacci sphere
-    const float z = 1 - (2 * float(i) + 1) / float(kCandidates), r = std::sqrt(std::max(0.0f, 1 - z * z));
-    const float phi = float(i) * kPi * (3 - std::sqrt(5.0f));
-    const float d[3] = {r * std::cos(phi), r * std::sin(phi), z};
+  for (int i = 0; i < kCandidates; ++i) {
+    float d[3];
+    fibonacci_sphere_direction(i, kCandidates, d);
     double score = 0;
     for (const auto &g : groups)
       if (dot3(g.data(), d) >= 0.5f) score += g[3];

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "base/errors.h"
+#include "base/directions.h"
 #include "base/vec3.h"
 #include "coverage/coverage_geometry.h"
 #include "coverage/coverage_settings.h"
@@ -22,7 +23,7 @@ LightSuggestion suggest_light_with_tolerance(const MeshView &mesh, const Shot &v
   if (robust_covered) *robust_covered = 0;
   const auto suggest = brute_force ? suggest_next_light_brute_force : suggest_next_light;
   if (tolerance_deg > 0) {
-    const float tol = tolerance_deg * kPi / 180, ts = std::acos(s.specular_threshold), td = std::acos(s.diffuse_threshold);
+    const float tol = float(radians(tolerance_deg)), ts = std::acos(s.specular_threshold), td = std::acos(s.diffuse_threshold);
     LightSuggestionSettings tight = s;
     if (kind == CoverageKind::Specular) {
       tight.specular_threshold = std::cos(std::max(0.0f, ts - tol));
@@ -131,13 +132,11 @@ LightSuggestion explore_directions(const NeedingSet &x, const Shot &viewpoint, C
   constexpr int kDirections = 600;
   constexpr size_t kMaxScored = 8000;  // larger sets are subsampled for the score
   const size_t stride = std::max<size_t>(1, (x.size() + kMaxScored - 1) / kMaxScored);
-  const float zmin = std::sin(s.min_elevation_deg * kPi / 180);
+  const float zmin = std::sin(radians(s.min_elevation_deg));
   std::vector<double> score(kDirections, 0);
   std::vector<std::array<float, 3>> dirs(kDirections), cams(kDirections);
   for (int d = 0; d < kDirections; ++d) {
-    const float z = zmin + (1 - zmin) * (float(d) + 0.5f) / float(kDirections), r = std::sqrt(std::max(0.0f, 1 - z * z));
-    const float phi = float(d) * kPi * (3 - std::sqrt(5.0f));
-    cams[size_t(d)] = {{r * std::cos(phi), r * std::sin(phi), z}};
+    fibonacci_cap_direction(d, kDirections, zmin, cams[size_t(d)].data());
     camera_to_world_direction(viewpoint, cams[size_t(d)].data(), dirs[size_t(d)].data());
   }
 #pragma omp parallel for schedule(dynamic, 8)
@@ -152,8 +151,8 @@ LightSuggestion explore_directions(const NeedingSet &x, const Shot &viewpoint, C
   out.valid = true;
   std::copy(dirs[best].begin(), dirs[best].end(), out.dir_world);
   std::copy(cams[best].begin(), cams[best].end(), out.dir_cam);
-  out.azimuth_deg = std::atan2(out.dir_cam[1], out.dir_cam[0]) * 180 / kPi;
-  out.elevation_deg = std::asin(std::min(1.0f, out.dir_cam[2])) * 180 / kPi;
+  out.azimuth_deg = degrees_f(std::atan2(out.dir_cam[1], out.dir_cam[0]));
+  out.elevation_deg = degrees_f(std::asin(std::min(1.0f, out.dir_cam[2])));
   const std::vector<uint64_t> near = near_mask(out.dir_world, taken, cone_cos, x.words);
   for (size_t i = 0; i < x.size(); ++i)
     if (counts_for(x, i, out.dir_world, near, kind, s)) ++out.covered_vertices, out.covered_weight += x.w[i];
@@ -173,7 +172,7 @@ LightSuggestion suggest_light_learning(const MeshView &mesh, const Shot &viewpoi
   };
   const LightSuggestion plain = suggest(needs);
   if (taken_lights.empty() || failure_cone_deg <= 0 || plain.needing_vertices == 0) return plain;
-  const float cone_cos = std::cos(failure_cone_deg * kPi / 180);
+  const float cone_cos = std::cos(radians(failure_cone_deg));
   const NeedingSet x = needing_set(mesh, viewpoint, visible, needs, kind, s, taken_lights);
   if (std::find(x.any_failed.begin(), x.any_failed.end(), 1) == x.any_failed.end()) return plain;  // nothing to learn
   std::vector<float> work(needs, needs + mesh.vertex_count);

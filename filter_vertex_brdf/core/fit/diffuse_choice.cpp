@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "base/mesh_adjacency.h"
+#include "base/number_format.h"
 
 #include <vcg/space/index/kdtree/kdtree.h>
 
@@ -150,11 +151,7 @@ std::vector<uint8_t> spread_over_mesh(const MeshView &mesh, const std::vector<st
   return coated;
 }
 
-std::string format_error(double e) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", e);
-  return text;
-}
+std::string format_error(double e) { return three_significant(e); }
 
 } // namespace
 

@@ -9,7 +9,7 @@
 #include "fit/materials.h"
 #include "fit/material_lobes.h"
 #include "fit/material_solve.h"
-#include "samples/lobe.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 namespace material_stage {

@@ -12,7 +12,7 @@
 #include "fit/label_spread.h"
 #include "fit/material_samples.h"
 #include "fit/materials.h"
-#include "samples/lobe.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 namespace material_stage {
@@ -69,7 +69,7 @@ inline float lobe_key(float s, bool ggx) {
   return ggx ? -(1.0f - s * s) : std::log(s);
 }
 
-// The lobe g(s, alpha) at one alpha from entry keys (samples/lobe.h lobe_value, the same values);
+// The lobe g(s, alpha) at one alpha from entry keys (model/lobe.h lobe_value, the same values);
 // GGX's a^2 is computed once for the many samples a loop evaluates at that alpha.
 struct LobeAt {
   double alpha = 1, a2 = 1;
@@ -80,12 +80,12 @@ struct LobeAt {
   double operator()(float key, float footprint) const {
     if (key > 0) return 0;
     if (ggx) return ggx_lobe_through_footprint(-double(key), a2, footprint);
-    return std::exp(std::max(alpha * double(key), -80.0));
+    return std::exp(std::max(alpha * double(key), kLobeLogFloor));
   }
 };
 inline double lobe_of(float key, double alpha, bool ggx) { return LobeAt(alpha, ggx)(key, 0.0f); }
 
-// (s^alpha)^2 = s^(2 alpha), as 0 below lobe_of's floor exp(-80): repeated squaring would otherwise
+// (s^alpha)^2 = s^(2 alpha), as 0 below lobe_of's floor exp(kLobeLogFloor): repeated squaring would otherwise
 // walk through denormals (slow, and meaningless as a weight).
 inline double square_lobe(double g) { return g < 1.8e-35 ? 0.0 : g * g; }
 

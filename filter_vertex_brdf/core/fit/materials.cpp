@@ -1,6 +1,7 @@
 #include "fit/materials.h"
 
 #include "base/mesh_adjacency.h"
+#include "base/number_format.h"
 #include "fit/heldout_folds.h"
 #include "fit/label_spread.h"
 #include "fit/material_labels.h"

@@ -17,13 +17,13 @@ struct FitSample {
   double u = 1;     // 1 - min(s, 1)^2 where s > 0 (with_ln_s): GGX's variable
 };
 
-// The lobe g(s, alpha) of the form for a fit sample (samples/lobe.h lobe_value, the same values up
+// The lobe g(s, alpha) of the form for a fit sample (model/lobe.h lobe_value, the same values up
 // to rounding); power forms from its stored logarithm (bit for bit lobe_value's); `a2`: ggx_a2(alpha),
 // once per alpha for the many samples of a vertex.
 inline double lobe(LobeForm form, const FitSample &x, double alpha, double a2) {
   if (!(x.s > 0)) return 0.0;
   if (!lobe_is_power(form)) return ggx_lobe_through_clamped_footprint(x.u, a2, x.v);
-  return std::exp(std::max(alpha * x.ln_s, -80.0));
+  return std::exp(std::max(alpha * x.ln_s, kLobeLogFloor));
 }
 
 inline FitSample with_ln_s(FitSample x) {
@@ -196,19 +196,6 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 }
 
 } // namespace
-
-void set_kd_color(const double rho[3], VertexFit &fit) {
-  const double kd = std::max(rho[0], std::max(rho[1], rho[2]));
-  fit.kd = float(kd);
-  for (int c = 0; c < 3; ++c) fit.color[c] = kd > 0 ? float(std::min(1.0, rho[c] / kd)) : 0.0f;
-}
-
-void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out[3], float footprint) {
-  const float d = std::max(d_in, 0.0f);
-  const float spec =
-      (d > 0 && fit.ks > 0) ? fit.ks * float(lobe_value(form, lobe_cos, fit.shininess, footprint)) : 0.0f;
-  for (int c = 0; c < 3; ++c) out[c] = fit.kd * d * fit.color[c] + spec;
-}
 
 namespace {
 // The fit's usable samples (see phong_fit.h); returns the number of highlight samples.

@@ -10,7 +10,7 @@ namespace vbrdf {
 
 namespace {
 
-constexpr double kDegree = kPi / 180.0;
+constexpr double kDegree = kRadiansPerDegree;
 constexpr double kHuber = 2.0;         // residuals beyond 2 sigma count linearly
 constexpr double kStep = 2e-3;         // numeric derivative step (radians of normal tilt)
 

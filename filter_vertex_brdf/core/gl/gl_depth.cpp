@@ -97,8 +97,8 @@ void finish_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
 
 void ensure_window_depth_target(const GlApi &gl, GlRenderTarget &t, int width, int height, const std::string &what) {
   if (!t.fbo) {
-    gl.GenFramebuffers(1, &t.fbo);
-    gl.GenTextures(1, &t.color);
+    t.fbo = GlObject::generate(gl, GlKind::Framebuffer);
+    t.color = GlObject::generate(gl, GlKind::Texture);
   }
   gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
   allocate_float_texture(gl, t.color, GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, width, height);
@@ -139,11 +139,11 @@ void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
   }
   const bool shading = kind == RenderTargetKind::ShadingAndDepth;
   if (!t.fbo) {
-    gl.GenFramebuffers(1, &t.fbo);
-    gl.GenTextures(1, &t.color);
-    gl.GenRenderbuffers(1, &t.depth);
+    t.fbo = GlObject::generate(gl, GlKind::Framebuffer);
+    t.color = GlObject::generate(gl, GlKind::Texture);
+    t.depth = GlObject::generate(gl, GlKind::Renderbuffer);
   }
-  if (shading && !t.extra) gl.GenTextures(1, &t.extra);
+  if (shading && !t.extra) t.extra = GlObject::generate(gl, GlKind::Texture);
   gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // else the null data pointer is an offset into it
   allocate_float_texture(gl, t.color, shading ? GL_RGBA32F : GL_R32F, shading ? GL_RGBA : GL_RED, width, height);
   if (shading) allocate_float_texture(gl, t.extra, GL_R32F, GL_RED, width, height);
@@ -168,11 +168,8 @@ void ensure_render_target_region(const GlApi &gl, GlRenderTarget &t, int width, 
   ensure_render_target(gl, t, width, height, kind, who, what);
 }
 
-void release_render_target(const GlApi &gl, GlRenderTarget &t) {
-  if (t.fbo) gl.DeleteFramebuffers(1, &t.fbo);
-  if (t.color) gl.DeleteTextures(1, &t.color);
-  if (t.extra) gl.DeleteTextures(1, &t.extra);
-  if (t.depth) gl.DeleteRenderbuffers(1, &t.depth);
+void release_render_target(const GlApi &, GlRenderTarget &t) {
+  t.fbo.reset(), t.color.reset(), t.extra.reset(), t.depth.reset();
   t = GlRenderTarget();
 }
 

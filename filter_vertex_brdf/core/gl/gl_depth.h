@@ -7,6 +7,7 @@
 #include <string>
 
 #include "base/mesh_view.h"
+#include "gl/gl_object.h"
 
 namespace vbrdf {
 
@@ -42,9 +43,9 @@ GlMeshFrame gl_mesh_frame(const MeshView &mesh, float depth_tolerance_fraction, 
 // R32F linear depth. WindowDepth has no colour output: `color` is then a 32F depth *texture* (the
 // rasteriser's window depth, which the caller converts: linear_depth_from_window) and `depth` is 0:
 // no fragment output to write (the shadow passes of 100 k x 32 on llvmpipe: visibility -11 %).
-// Names are GL object names (GLuint); 0 = not allocated.
+// The objects free themselves (GlObject); a name 0 = not allocated.
 struct GlRenderTarget {
-  unsigned fbo = 0, color = 0, extra = 0, depth = 0;
+  GlObject fbo, color, extra, depth;
   int width = 0, height = 0;                      // the size in use (passes draw and read this much)
   int allocated_width = 0, allocated_height = 0;  // the size of the GL objects (>= the size in use)
 };
@@ -70,7 +71,7 @@ void ensure_render_target(const GlApi &gl, GlRenderTarget &t, int width, int hei
 // (texelFetch), not normalised coordinates.
 void ensure_render_target_region(const GlApi &gl, GlRenderTarget &t, int width, int height, RenderTargetKind kind,
                                  const std::string &who, const std::string &what);
-// Deletes the GL objects of `t` (the context must be current) and resets it.
+// Deletes the GL objects of `t` now (the context must be current) and resets it.
 void release_render_target(const GlApi &gl, GlRenderTarget &t);
 
 // Throws ProcessingError ("<who>: <what> needs a WxH render target, but this OpenGL allows at most

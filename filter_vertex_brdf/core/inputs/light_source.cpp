@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "base/angles.h"
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "inputs/light_file.h"
@@ -405,7 +406,7 @@ std::string describe_lights(const std::vector<LightSource> &lights, const LightP
     ++points;
     const float d = length3({{l.position[0] - c[0], l.position[1] - c[1], l.position[2] - c[2]}});
     dmin = std::min(dmin, d), dmax = std::max(dmax, d);
-    if (d > half) subtended = std::max(subtended, float(2 * std::asin(half / d) * 180 / M_PI));
+    if (d > half) subtended = std::max(subtended, degrees_f(2 * std::asin(half / d)));
   }
   if (points == 0) {
     s << lights.size() << " directional lights";

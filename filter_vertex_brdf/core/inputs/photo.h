@@ -17,6 +17,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "base/clip_level.h"
+
 namespace vbrdf {
 
 enum class PhotoEncoding { Auto = 0, SRGB = 1, Linear = 2 };
@@ -43,7 +45,7 @@ struct Photo {
 // Loads a photo. `saturation_level` in (0,1]: a channel >= level * max code counts as clipped.
 // Throws InputError naming the file when it is missing/unreadable, not 8/16-bit, or (when
 // expected_width/height > 0) its size differs from the raster's viewport.
-Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level = 0.99f,
+Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturation_level = kSaturationLevel,
                  int expected_width = 0, int expected_height = 0);
 
 // A photo the host application has already decoded, e.g. MeshLab's QImage of a raster.
@@ -58,7 +60,7 @@ using HostPhotos = std::map<std::string, HostPixels>;  // by photo path (Raster:
 // table, saturation code and size check; nothing is copied). Throws InputError naming `path`
 // when the size differs from the expected one or the pixels are not 8/16-bit with 1..4 channels.
 Photo photo_from_host(const std::string &path, const HostPixels &host, PhotoEncoding encoding,
-                      float saturation_level = 0.99f, int expected_width = 0, int expected_height = 0);
+                      float saturation_level = kSaturationLevel, int expected_width = 0, int expected_height = 0);
 
 // The photo as linear RGB float (CV_32FC3, its own decoding table: exactly the values its samples
 // get) and, when `clipped` is given, a CV_8U mask of its clipped pixels (255 where any channel is

@@ -23,8 +23,8 @@ struct VertexRecord {
   float n_visible = 0.0f, n_diffuse = 0.0f, n_specular = 0.0f;
   float coloured = 0.0f;  // 0 input colour kept, 1 clean pixels, 2 rim/mixed pixels only, 3 neighbours
   float material = 0.0f;  // material stage (materials.h): 1..K, 0 = none (stage off, or no model)
-  float lobe_form = 0.0f;  // LobeForm of the fit (samples/lobe.h): 0 R.E, 1 N.H; one value per result
-  float diffuse_form = 0.0f;  // DiffuseForm at the vertex (samples/diffuse_form.h): 0 Lambert, 1 coated
+  float lobe_form = 0.0f;  // LobeForm of the fit (model/lobe.h): 0 R.E, 1 N.H; one value per result
+  float diffuse_form = 0.0f;  // DiffuseForm at the vertex (model/diffuse_form.h): 0 Lambert, 1 coated
   float diffuse_deconvolved = 0.0f;  // 1: k_d C deconvolved through the pixel footprints (albedo_deconvolution.h)
   float mesh_normal[3] = {0.0f, 0.0f, 0.0f};  // the mesh's normal (the geometry's nx ny nz are the shading normal)
   float normal_moved = -1.0f;  // degrees from the mesh normal to the shading normal; -1 not determined (shading_normals.h)

@@ -265,7 +265,7 @@ std::string describe_registration(const ViewpointRegistration &v, const Registra
   if (!v.applied) return s + ", below " + fixed(settings.threshold_px) + " px: camera unchanged";
   s += " -> " + fixed(v.after_px) + " px after correction (shift " + fixed(v.shift_x) + ", " + fixed(v.shift_y) +
        " px at the principal point";
-  s += v.roll_determined ? ", roll " + fixed(v.correction.roll * 180.0 / kPi, 3) + " deg" : ", roll not determined";
+  s += v.roll_determined ? ", roll " + fixed(degrees(v.correction.roll), 3) + " deg" : ", roll not determined";
   s += v.scale_determined ? ", focal x" + fixed(std::exp(v.correction.log_scale), 4) : ", focal not determined";
   return s + ")";
 }

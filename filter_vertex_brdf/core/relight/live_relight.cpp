@@ -145,21 +145,19 @@ class LiveRelight::Impl {
 public:
   Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc, LobeForm lobe,
        const DiffuseForms &diffuse);
-  ~Impl() { release(); }
   void draw(const LiveView &view);
   std::vector<float> render_offscreen(const LiveView &view, int width, int height, bool read_back);
   size_t vertex_count = 0;
 
 private:
   void upload(const MeshView &mesh, const std::vector<VertexFit> &fits);
-  void release();
 
-  GlApi gl_;
+  GlApi gl_;  // before the GL objects: they free themselves through it
   LobeForm lobe_;
   DiffuseForms diffuse_;
   PhongMeshBuffers mesh_;
   double origin_[3] = {0, 0, 0};
-  GLuint program_ = 0;
+  GlObject program_;
   GlRenderTarget target_;
 };
 
@@ -174,26 +172,15 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   vertex_count = mesh.vertex_count;
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
-  try {
-    program_ = build_program(gl_, kLiveVertexShader, phong_program_source(kLiveFragmentMain).c_str(),
-                             "the live relighting pass");
-    upload(mesh, fits);
-    check_gl_error(gl_, "the upload of the mesh for live relighting");
-  } catch (...) {
-    release();
-    throw;
-  }
+  program_ = GlObject::adopt(gl_, GlKind::Program,
+                             build_program(gl_, kLiveVertexShader, phong_program_source(kLiveFragmentMain).c_str(),
+                                           "the live relighting pass"));
+  upload(mesh, fits);
+  check_gl_error(gl_, "the upload of the mesh for live relighting");
 }
 
 void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
   mesh_ = upload_phong_mesh(gl_, mesh, origin_, fits, diffuse_);
-}
-
-void LiveRelight::Impl::release() {
-  release_render_target(gl_, target_);
-  release_phong_mesh(gl_, mesh_);
-  if (program_) gl_.DeleteProgram(program_);
-  program_ = 0;
 }
 
 void LiveRelight::Impl::draw(const LiveView &view) {

@@ -17,8 +17,8 @@
 #include "base/mesh_view.h"
 #include "fit/phong_fit.h"
 #include "gl/gl_context.h"  // GetProcAddressFn
-#include "samples/diffuse_form.h"
-#include "samples/lobe.h"
+#include "model/diffuse_form.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 

@@ -38,7 +38,7 @@ Shot orbit_shot(const Shot &base, const float pivot[3], float azimuth_deg, float
   const vcg::Matrix44f rot = base.Extrinsics.Rot();
   vcg::Point3f axis[3];
   for (int i = 0; i < 3; ++i) axis[i] = vcg::Point3f(rot[i][0], rot[i][1], rot[i][2]);
-  const float deg = float(M_PI / 180.0);
+  const float deg = float(kRadiansPerDegree);
   const vcg::Point3f p(pivot[0], pivot[1], pivot[2]);
   // Azimuth about the camera's up axis (y), then elevation about the rotated right axis (x):
   // positive elevation moves the camera up, i.e. a rotation by -elevation about x.

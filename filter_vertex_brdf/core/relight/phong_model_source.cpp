@@ -57,9 +57,9 @@ PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const 
   }
   PhongMeshBuffers b;
   b.index_count = mesh.index_count;
-  gl.GenVertexArrays(1, &b.vao);
+  b.vao = GlObject::generate(gl, GlKind::VertexArray);
   gl.BindVertexArray(b.vao);
-  gl.GenBuffers(1, &b.vbo);
+  b.vbo = GlObject::generate(gl, GlKind::Buffer);
   gl.BindBuffer(GL_ARRAY_BUFFER, b.vbo);
   gl.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
   const GLsizei stride = kFloats * sizeof(float);
@@ -69,17 +69,15 @@ PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const 
                            reinterpret_cast<const void *>(size_t(offsets[a]) * sizeof(float)));
     gl.EnableVertexAttribArray(a);
   }
-  gl.GenBuffers(1, &b.ibo);
+  b.ibo = GlObject::generate(gl, GlKind::Buffer);
   gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, b.ibo);  // recorded in our VAO only
   gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.index_count * sizeof(uint32_t)), mesh.indices,
                 GL_STATIC_DRAW);
   return b;
 }
 
-void release_phong_mesh(const GlApi &gl, PhongMeshBuffers &b) {
-  if (b.vao) gl.DeleteVertexArrays(1, &b.vao);
-  if (b.vbo) gl.DeleteBuffers(1, &b.vbo);
-  if (b.ibo) gl.DeleteBuffers(1, &b.ibo);
+void release_phong_mesh(const GlApi &, PhongMeshBuffers &b) {
+  b.vao.reset(), b.vbo.reset(), b.ibo.reset();
   b = PhongMeshBuffers();
 }
 

@@ -10,8 +10,9 @@
 
 #include "base/mesh_view.h"
 #include "fit/phong_fit.h"
-#include "samples/diffuse_form.h"
-#include "samples/lobe.h"
+#include "gl/gl_object.h"
+#include "model/diffuse_form.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 
@@ -39,13 +40,14 @@ float typical_shininess(const std::vector<VertexFit> &fits);
 //   4 vec3 (fit_status, DQ, SQ; NaN quality as 0): the live view's false colours
 // and the mesh's indices, recorded in a new vertex array object (left bound). `fits` and
 // `diffuse` have one entry per vertex.
+// The objects free themselves (GlObject).
 struct PhongMeshBuffers {
-  unsigned vao = 0, vbo = 0, ibo = 0;
+  GlObject vao, vbo, ibo;
   size_t index_count = 0;
 };
 PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
                                    const std::vector<VertexFit> &fits, const DiffuseForms &diffuse);
-// Deletes what upload_phong_mesh created (zero handles are skipped) and zeroes `buffers`.
+// Deletes what upload_phong_mesh created now (the context must be current) and zeroes `buffers`.
 void release_phong_mesh(const GlApi &gl, PhongMeshBuffers &buffers);
 
 } // namespace vbrdf

@@ -12,6 +12,7 @@
 
 #include "base/color_difference.h"
 #include "base/errors.h"
+#include "base/number_format.h"
 #include "base/file_util.h"
 #include "base/output_file.h"
 #include "base/vec3.h"
@@ -81,9 +82,8 @@ cv::Mat colour_bar(int width, float max_de, double font) {
   cv::Mat colours;
   cv::applyColorMap(ramp, colours, cv::COLORMAP_TURBO);
   for (int y = 0; y < bar_h; ++y) colours.row(0).copyTo(strip.row(y));
-  char text[64];
   for (int t = 0; t <= 2; ++t) {
-    std::snprintf(text, sizeof text, t == 2 ? "%.3g dE2000" : "%.3g", double(max_de) * t / 2);
+    const std::string text = three_significant(double(max_de) * t / 2) + (t == 2 ? " dE2000" : "");
     int base = 0;
     const cv::Size size = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, font * 0.8, 1, &base);
     const int x = std::min(std::max(0, (width - 1) * t / 2 - size.width / 2), width - size.width);

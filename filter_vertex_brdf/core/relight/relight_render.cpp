@@ -136,24 +136,22 @@ class RelightRenderer::Impl {
 public:
   Impl(const MeshView &mesh, const std::vector<VertexFit> &fits, const GetProcAddressFn &get_proc,
        const RelightRenderSettings &settings);
-  ~Impl() { release(); }
   RelitImage render(const Shot &shot, const LightSource &light);
   std::string renderer;
 
 private:
   void upload(const MeshView &mesh, const std::vector<VertexFit> &fits);
-  void release();
   void shadow_pass(const LightView &lv);
   void camera_pass(const Shot &shot, const LightSource &light, const LightView &lv, RelitImage &out);
   void draw();
 
-  GlApi gl_;
+  GlApi gl_;  // before the GL objects: they free themselves through it
   RelightRenderSettings settings_;
   PhongMeshBuffers mesh_;
   float origin_[3] = {0, 0, 0};
   float corners_[8][3] = {};
   float radius_ = 0, tolerance_ = 0;
-  GLuint shade_program_ = 0, shadow_program_ = 0;
+  GlObject shade_program_, shadow_program_;
   GlRenderTarget camera_target_, shadow_target_;
 };
 
@@ -175,30 +173,20 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   renderer = gl_.version_string();
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
-  try {
-    check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the shadow map");
-    shade_program_ = build_program(gl_, kShadeVertexShader, phong_program_source(kShadeFragmentMain).c_str(), "the relighting pass");
-    shadow_program_ = build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map");
-    upload(mesh, fits);
-    check_gl_error(gl_, "the upload of the mesh for relighting");
-  } catch (...) {
-    release();  // the destructor does not run when the constructor throws
-    throw;
-  }
+  check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the shadow map");
+  shade_program_ = GlObject::adopt(
+      gl_, GlKind::Program,
+      build_program(gl_, kShadeVertexShader, phong_program_source(kShadeFragmentMain).c_str(), "the relighting pass"));
+  shadow_program_ = GlObject::adopt(
+      gl_, GlKind::Program,
+      build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map"));
+  upload(mesh, fits);
+  check_gl_error(gl_, "the upload of the mesh for relighting");
 }
 
 void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
   const double origin[3] = {origin_[0], origin_[1], origin_[2]};
   mesh_ = upload_phong_mesh(gl_, mesh, origin, fits, settings_.diffuse);
-}
-
-void RelightRenderer::Impl::release() {
-  release_render_target(gl_, camera_target_);
-  release_render_target(gl_, shadow_target_);
-  release_phong_mesh(gl_, mesh_);
-  if (shade_program_) gl_.DeleteProgram(shade_program_);
-  if (shadow_program_) gl_.DeleteProgram(shadow_program_);
-  shade_program_ = shadow_program_ = 0;
 }
 
 void RelightRenderer::Impl::draw() {

@@ -53,10 +53,10 @@ struct RelitImage {
 };
 
 struct RelightRenderSettings {
-  int shadow_map_size = 0;        // light-view depth map, pixels per side; 0 = automatic, as the
+  int shadow_map_size = kDefaultShadowMapSize;  // light-view depth map, pixels per side; 0 = automatic, as the
                                   // fit's visibility pass (resolved_shadow_map_size)
-  float depth_tolerance = 0.002f; // shadow test slack, fraction of the bounding-box diagonal
-  LobeForm lobe = LobeForm::PhongRE;  // the fit's lobe form (its result's lobe_form; lobe.h)
+  float depth_tolerance = kDefaultDepthTolerance; // shadow test slack, fraction of the bounding-box diagonal
+  LobeForm lobe = kDefaultLobe;  // the fit's lobe form (its result's lobe_form; lobe.h)
   DiffuseForms diffuse;  // the fit's diffuse forms, per vertex where they vary (its result's diffuse_form; diffuse_form.h)
 };
 

@@ -36,7 +36,7 @@ struct RelightOutputOptions {
   int sheet_columns = 2;
   int sheet_panel_width = 1200;   // width of one side-by-side panel in the contact sheet
   PhotoEncoding encoding = PhotoEncoding::Auto;
-  float saturation_level = 0.99f;
+  float saturation_level = kSaturationLevel;
   ColorCorrectionChoice color_correction = ColorCorrectionChoice::Auto;  // color_plan.h, as the fit's
   std::vector<float> chart_corners;  // as FitSettings::chart_corners: empty, 8, or 8 per viewpoint
   ExposureMode exposure = ExposureMode::Auto;

@@ -21,6 +21,7 @@
 #include "fit/shading_normals.h"
 #include "base/mesh_view.h"
 #include "base/output_file.h"
+#include "model/defaults.h"
 #include "io/output_ply.h"
 #include "io/vertex_quality.h"  // QualityOutput
 #include "samples/samples.h"
@@ -30,29 +31,9 @@
 
 namespace vbrdf {
 
-// The fit's T_d (N.L below which a sample is "grazing"): 0.2, not the thesis's 0.5. With errors
-// weighted by N.L, grazing samples help more than they hurt: over the whole visible surface the
-// held-out error falls on every shared scene as T_d goes from 0.5 to 0.2 (spot_dir24 1.16 -> 1.12,
-// bunny 0.98 -> 0.96, teapot 1.63 -> 1.57 mean CIEDE2000; docs/decisions/whole_surface.md),
-// and little more below. Coverage keeps 0.5: it asks the photographer for well-lit samples.
-constexpr float kFitDiffuseThreshold = 0.2f;
-
-// The product's lobe form (the filter's and vbrdf_fit's default; docs/decisions/ggx_lobe.md has the
-// measurements that chose it). PhongFitOptions keeps the thesis's R.E as the core contract's
-// default; the pipeline copies phong.lobe into gather.lobe.
-constexpr LobeForm kFitLobe = LobeForm::GgxNH;
-
-// How the fit's diffuse form (diffuse_form.h) is decided. Auto (the product's default): a pilot fit
-// on each form with photos held out picks it per scene (diffuse_choice.h;
-// docs/decisions/diffuse_form.md has the measurements behind it); Lambert / Coated: as given.
-enum class DiffuseTermChoice { Auto = 0, Lambert = 1, Coated = 2 };
-constexpr DiffuseTermChoice kFitDiffuseChoice = DiffuseTermChoice::Auto;
-
+// Every default is the product's (model/defaults.h: the lobe, T_s, T_d, the diffuse form); the
+// pipeline copies phong.lobe into gather.lobe.
 struct FitSettings {
-  FitSettings() {
-    gather.diffuse_threshold = kFitDiffuseThreshold;
-    phong.lobe = gather.lobe = kFitLobe;
-  }
   GatherSettings gather;
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;

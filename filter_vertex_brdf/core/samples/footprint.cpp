@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "samples/lobe.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 namespace {

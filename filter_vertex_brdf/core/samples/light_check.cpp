@@ -6,6 +6,7 @@
 
 #include "base/errors.h"
 #include "base/file_util.h"
+#include "base/luminance.h"
 
 namespace vbrdf {
 
@@ -21,7 +22,7 @@ void LightAgreement::add(const SampleChunk &chunk, const MeshView &mesh, const s
       if ((s.flags & (kSaturated | kMixedPixel)) || s.raster >= n_.size()) continue;
       // N.L signed (not clamped): the vertices facing away from the light must be the dark ones.
       const double predicted = double(s.d) * light_irradiance_at(lights[s.raster], x);
-      const double lum = 0.2126 * s.rgb[0] + 0.7152 * s.rgb[1] + 0.0722 * s.rgb[2];
+      const double lum = luminance_double(s.rgb);
       if (!std::isfinite(predicted) || !std::isfinite(lum)) continue;
       const size_t r = s.raster;
       n_[r] += 1, sx_[r] += predicted, sy_[r] += lum;

@@ -14,8 +14,9 @@
 
 #include "base/callbacks.h"  // ProgressFn
 #include "inputs/camera.h"
-#include "samples/diffuse_form.h"
-#include "samples/lobe.h"
+#include "model/defaults.h"
+#include "model/diffuse_form.h"
+#include "model/lobe.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
 #include "inputs/photo.h"
@@ -83,10 +84,10 @@ inline bool is_specular_sample(const Sample &s) {
 }
 
 struct GatherSettings {
-  float specular_threshold = 0.9f;   // T_s on R.E
-  float diffuse_threshold = 0.5f;    // T_d on N.L
+  float specular_threshold = kDefaultSpecularThreshold;  // T_s on R.E
+  float diffuse_threshold = kFitDiffuseThreshold;        // T_d on N.L (coverage: CoverageSettings sets its own)
   PhotoEncoding encoding = PhotoEncoding::Auto;
-  float saturation_level = 0.99f;    // fraction of the maximum code value counted as clipped
+  float saturation_level = kSaturationLevel;   // fraction of the maximum code value counted as clipped
   size_t photo_cache_bytes = size_t(2) << 30;  // decoded photos kept in memory
   // Photos the host application has already decoded (the plugin: MeshLab's raster images), read
   // in place instead of decoded again; they take none of photo_cache_bytes. Empty: decode files.
@@ -99,7 +100,7 @@ struct GatherSettings {
   bool own_surface_texels = true;
   // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
   // (run/fit_run.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
-  LobeForm lobe = LobeForm::PhongRE;
+  LobeForm lobe = kDefaultLobe;
   // The diffuse term's form stored in Sample::d (diffuse_form.h), per vertex where it varies
   // (gather_samples; make_sample takes `uniform`). kGrazing stays N.L < T_d on the plain cosine.
   DiffuseForms diffuse;

@@ -10,17 +10,18 @@
 #include "inputs/camera.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
+#include "model/defaults.h"
 
 namespace vbrdf {
 
 struct VisibilitySettings {
   // Depth tolerance as a fraction of the mesh bounding-box diagonal: a vertex counts as visible
   // when it is at most this much behind the first surface along the ray.
-  float depth_tolerance = 0.002f;
+  float depth_tolerance = kDefaultDepthTolerance;
   // Resolution (square) of the light-view depth map over the mesh bounds. 0 = automatic: per
   // light, from the mesh's edges as the light sees them, at most resolved_shadow_map_size
   // (pass_size.h: light_pass_size).
-  int shadow_map_size = 0;
+  int shadow_map_size = kDefaultShadowMapSize;
   // GL camera pass: rendered at 1/d of the photo's resolution per axis. 0 = automatic (from the
   // mesh's edges as the camera sees them, pass_size.h: camera_pass_divisor); 1 = the photo's
   // resolution.

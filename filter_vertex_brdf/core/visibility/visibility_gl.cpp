@@ -82,7 +82,6 @@ inline uint8_t footprint_code(const float *map, int w, int h, int divisor, int p
 class GlVisibility : public VisibilityBackend {
 public:
   GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_proc, const VisibilitySettings &settings);
-  ~GlVisibility() override;
   const char *name() const override {
     return test_program_ ? "OpenGL (depth tests in a compute shader)" : "OpenGL (depth maps read back, tested on the CPU)";
   }
@@ -92,7 +91,6 @@ public:
 
 private:
   void upload_mesh();
-  void release_gl();
   void render_depth(const GlRenderTarget &target, const Mat4 &view, const Mat4 &projection, const std::string &what,
                     bool depth_only = false);
   void read_depth(const GlRenderTarget &target, const std::string &what);
@@ -112,20 +110,20 @@ private:
 
   MeshView mesh_;
   VisibilitySettings settings_;
-  GlApi gl_;
+  GlApi gl_;  // before the GL objects: they free themselves through it
   float origin_[3] = {0, 0, 0};  // bounding-box centre: positions are uploaded relative to it
   float corners_[8][3] = {};     // bounding-box corners, relative to origin_
   float radius_ = 0;             // bounding sphere radius around origin_
   float tolerance_ = 0;          // settings.depth_tolerance * bbox diagonal (world units)
-  GLuint program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+  GlObject program_, vao_, vbo_, ibo_;
   GLint u_view_ = -1, u_projection_ = -1;
   // Directional lights with the GPU tests: a depth-only pass (no fragment output; the tests read
   // the window depth and unproject it): the visibility stage of 100 k x 32 on llvmpipe -11 %.
-  GLuint depth_only_program_ = 0;
+  GlObject depth_only_program_;
   GLint d_view_ = -1, d_projection_ = -1;
   GlRenderTarget camera_target_, light_target_, light_window_target_;
-  GLuint test_program_ = 0, codes_ = 0;  // compute-shader tests; 0 when they are off or unsupported
-  GLuint only_ = 0;                      // the light pass's `only` bits, for the tests
+  GlObject test_program_, codes_;  // compute-shader tests; none when they are off or unsupported
+  GlObject only_;                  // the light pass's `only` bits, for the tests
   struct TestUniforms {
     GLint vertex_count = -1, first_word = -1, light_pass = -1, view = -1, projection = -1, width = -1, height = -1;
     GLint tolerance = -1, slack_per_depth = -1, light_scale = -1, perspective = -1, depth = -1;
@@ -154,36 +152,14 @@ GlVisibility::GlVisibility(const MeshView &mesh, const GetProcAddressFn &get_pro
 
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);  // errors left by the host are not ours
-  try {
-    program_ = build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the visibility depth pass");
-    u_view_ = gl_.GetUniformLocation(program_, "u_view");
-    u_projection_ = gl_.GetUniformLocation(program_, "u_projection");
-    upload_mesh();
-    check_gl_error(gl_, "the upload of the mesh for the visibility passes");
-    if (settings_.depth_tests_on_gpu && gl_.has_compute) build_test_program();
-  } catch (...) {
-    release_gl();  // the destructor does not run when the constructor throws
-    throw;
-  }
-}
-
-GlVisibility::~GlVisibility() { release_gl(); }
-
-void GlVisibility::release_gl() {
-  release_render_target(gl_, camera_target_);
-  release_render_target(gl_, light_target_);
-  release_render_target(gl_, light_window_target_);
-  if (depth_only_program_) gl_.DeleteProgram(depth_only_program_);
-  depth_only_program_ = 0;
-  if (vao_) gl_.DeleteVertexArrays(1, &vao_);
-  if (vbo_) gl_.DeleteBuffers(1, &vbo_);
-  if (ibo_) gl_.DeleteBuffers(1, &ibo_);
-  if (program_) gl_.DeleteProgram(program_);
-  if (test_program_) gl_.DeleteProgram(test_program_);
-  if (codes_) gl_.DeleteBuffers(1, &codes_);
-  if (only_) gl_.DeleteBuffers(1, &only_);
-  vao_ = vbo_ = ibo_ = program_ = test_program_ = codes_ = only_ = 0;
-  codes_bytes_ = only_bytes_ = 0;
+  program_ = GlObject::adopt(
+      gl_, GlKind::Program,
+      build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the visibility depth pass"));
+  u_view_ = gl_.GetUniformLocation(program_, "u_view");
+  u_projection_ = gl_.GetUniformLocation(program_, "u_projection");
+  upload_mesh();
+  check_gl_error(gl_, "the upload of the mesh for the visibility passes");
+  if (settings_.depth_tests_on_gpu && gl_.has_compute) build_test_program();
 }
 
 void GlVisibility::upload_mesh() {
@@ -193,14 +169,14 @@ void GlVisibility::upload_mesh() {
   for (size_t v = 0; v < mesh_.vertex_count; ++v)
     for (int k = 0; k < 3; ++k) local[3 * v + k] = mesh_.positions[3 * v + k] - origin_[k];
 
-  gl_.GenVertexArrays(1, &vao_);
+  vao_ = GlObject::generate(gl_, GlKind::VertexArray);
   gl_.BindVertexArray(vao_);
-  gl_.GenBuffers(1, &vbo_);
+  vbo_ = GlObject::generate(gl_, GlKind::Buffer);
   gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
   gl_.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(local.size() * sizeof(float)), local.data(), GL_STATIC_DRAW);
   gl_.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
   gl_.EnableVertexAttribArray(0);
-  gl_.GenBuffers(1, &ibo_);
+  ibo_ = GlObject::generate(gl_, GlKind::Buffer);
   gl_.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_);  // recorded in our VAO only
   gl_.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh_.index_count * sizeof(uint32_t)), mesh_.indices,
                  GL_STATIC_DRAW);
@@ -243,9 +219,10 @@ void GlVisibility::read_depth(const GlRenderTarget &t, const std::string &what) 
 // compile it (a driver bug, a 4.3 context without GLSL 430) keeps the read-back path.
 void GlVisibility::build_test_program() {
   try {
-    test_program_ = build_compute_program(gl_, shaders::visibility_test_comp, "the visibility depth tests");
+    test_program_ = GlObject::adopt(gl_, GlKind::Program,
+                                    build_compute_program(gl_, shaders::visibility_test_comp, "the visibility depth tests"));
   } catch (const ProcessingError &) {
-    test_program_ = 0;
+    test_program_.reset();
     clear_gl_errors(gl_);
     return;
   }
@@ -256,11 +233,13 @@ void GlVisibility::build_test_program() {
   tu_.light_scale = at("u_light_scale"), tu_.perspective = at("u_perspective"), tu_.depth = at("u_depth");
   tu_.divisor = at("u_divisor"), tu_.photo_width = at("u_photo_width"), tu_.photo_height = at("u_photo_height");
   tu_.window_depth = at("u_window_depth"), tu_.unproject = at("u_unproject"), tu_.only = at("u_only");
-  depth_only_program_ = build_program(gl_, kLinearDepthVertexShader, kDepthOnlyFragmentShader, "the depth-only light pass");
+  depth_only_program_ = GlObject::adopt(
+      gl_, GlKind::Program,
+      build_program(gl_, kLinearDepthVertexShader, kDepthOnlyFragmentShader, "the depth-only light pass"));
   d_view_ = gl_.GetUniformLocation(depth_only_program_, "u_view");
   d_projection_ = gl_.GetUniformLocation(depth_only_program_, "u_projection");
-  gl_.GenBuffers(1, &codes_);
-  gl_.GenBuffers(1, &only_);
+  codes_ = GlObject::generate(gl_, GlKind::Buffer);
+  only_ = GlObject::generate(gl_, GlKind::Buffer);
 }
 
 // Tests every vertex against the depth map of `t` in the compute shader and reads the codes back

@@ -42,6 +42,11 @@ enum class DiffuseForm : uint8_t { Lambert = 0, Coated = 1 };
 constexpr float kCoatIndex = 1.5f;       // refractive index of the coat (varnishes, plastics: 1.45-1.55)
 constexpr float kCoatMinCosine = 0.2f;   // clamp on N.L and N.E before T (see "Why the clamp" above)
 
+// How the fit's diffuse form is decided. Auto: a pilot fit on each form with photos held out picks
+// it per scene (fit/diffuse_choice.h; docs/decisions/diffuse_form.md has the measurements behind
+// it); Lambert / Coated: as given. The default is the table's (defaults.h kFitDiffuseChoice).
+enum class DiffuseTermChoice { Auto = 0, Lambert = 1, Coated = 2 };
+
 // "lambert" / "coated" (PLY comment, report, command-line value).
 inline const char *diffuse_form_name(DiffuseForm f) { return f == DiffuseForm::Coated ? "coated" : "lambert"; }
 

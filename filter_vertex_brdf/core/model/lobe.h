@@ -74,6 +74,10 @@ inline double ggx_lobe_of_u(double u, double alpha) { return ggx_lobe_of_u_a2(u,
 // was). v is clamped to kMaxFootprintVariance (Tokuyoshi & Kaplanyan's clamp, 0.18).
 constexpr double kMaxFootprintVariance = 0.18;
 
+// The floor on alpha ln s of the power forms: exp of it is 1.8e-35, far above float's denormals, and
+// ln 0 never reaches exp.
+constexpr double kLobeLogFloor = -80.0;
+
 // GGX seen through a footprint whose variance is already clamped, v_clamped = min(v,
 // kMaxFootprintVariance) >= 0 (clamped_footprint), from u = 1 - s^2 and a2 = ggx_a2(alpha): no
 // branch, for loops over many a2 at one sample (vectorises); at 0 equal to ggx_lobe_of_u_a2 up to
@@ -92,7 +96,7 @@ inline double ggx_lobe_through_footprint(double u, double a2, double v) {
 }
 
 // g(s, alpha) of the form (see the header comment), for alpha >= 0. s <= 0 gives 0; s is clamped at
-// 1. Power forms: exp(max(alpha ln s, -80)) (no ln 0, no overflow, no denormals). GGX: a^2 in
+// 1. Power forms: exp(max(alpha ln s, kLobeLogFloor)) (no ln 0, no overflow, no denormals). GGX: a^2 in
 // (0, 1] for alpha >= 0, the denominator >= a^2 > 0, so g is in (0, 1] for s > 0 (never 0: the
 // GGX tail is long; 1e-38-ish only for alpha near 1e38).
 // `footprint`: the sample's footprint variance v (above; GGX only), 0 = the surface's own lobe.
@@ -101,7 +105,7 @@ inline double lobe_value(LobeForm f, double s, double alpha, double footprint = 
   s = s < 1 ? s : 1;
   if (lobe_is_power(f)) {
     const double x = alpha * std::log(s);
-    return std::exp(x > -80.0 ? x : -80.0);
+    return std::exp(x > kLobeLogFloor ? x : kLobeLogFloor);
   }
   return ggx_lobe_through_footprint(1 - s * s, ggx_a2(alpha), footprint);
 }
