@@ -9,8 +9,8 @@
 # when a shader changes; the file list is re-globbed when a shader is added or removed), adds them
 # to the target, puts the folder on its include path and defines VBRDF_EMBEDDED_SHADERS=1 for it.
 # The header declares, in namespace vbrdf::shaders, one `extern const char *const <name>` per file
-# (file name with every non-alphanumeric character replaced by '_': phong_fit.comp ->
-# phong_fit_comp) and `const char *find(const char *file_name)` (null when absent).
+# (file name with every non-alphanumeric character replaced by '_': reflectance_fit.comp ->
+# reflectance_fit_comp) and `const char *find(const char *file_name)` (null when absent).
 #
 # The same file is the generator: cmake -DSHADER_DIR=<dir> -DOUT_DIR=<dir> -P embed_shaders.cmake
 
@@ -48,7 +48,7 @@ namespace vbrdf {
 namespace shaders {
 
 ${decls}
-// Source of the shader file `file_name` (e.g. \"phong_fit.comp\"), or null when it is not embedded.
+// Source of the shader file `file_name` (e.g. \"reflectance_fit.comp\"), or null when it is not embedded.
 const char *find(const char *file_name);
 
 } // namespace shaders

@@ -129,7 +129,7 @@ std::string light_file(const RichParameterList &params) { return path(params, kL
 
 void add_specular_threshold(RichParameterList &params) {
   params.addParam(RichFloat(kSpecularThreshold, vbrdf::kDefaultSpecularThreshold,
-                            "Specular threshold (R.E)",
+                            "Highlight threshold (R.E, any lobe)",
                             "A lit sample whose mirror direction R is this close to the view direction E "
                             "(R.E above the threshold, in (0,1]) is a highlight: excluded from the diffuse "
                             "colour, counted as specular evidence (and as specular coverage)."));
@@ -228,7 +228,7 @@ void add_min_specular_samples(RichParameterList &params) {
                           "needs before k_s and shininess are fitted; with fewer the fit gives it a "
                           "diffuse-only model (k_s = 0), which guards against 'diffuse holes' (k_d ~ 0, huge "
                           "k_s). Coverage counts a vertex as fully covered from the same number, so that "
-                          "'fully covered' means a full Phong fit. Range [1, 1000]."));
+                          "'fully covered' means a full fit. Range [1, 1000]."));
 }
 
 int min_specular_samples(const RichParameterList &params) {

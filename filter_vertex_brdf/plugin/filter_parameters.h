@@ -10,7 +10,7 @@
 //
 // Where the filters could differ, one rule holds in all of them (docs/architecture.md#filter-parameters-one-owner-each):
 // - minSpecularSamples: 2 (the fit's) in coverage too, so that "fully covered" means what the fit
-//   needs for a Phong fit rather than a diffuse-only one.
+//   needs for a reflectance fit rather than a diffuse-only one.
 // - shadowMapSize: 0 = automatic (from the mesh's edge lengths) in every filter, coverage included.
 // - viewpointRaster -1: MeshLab's current raster (the last one loaded or imported, unless another
 //   was selected), in coverage as in the sphere filter.

@@ -47,7 +47,7 @@ QString FitFilter::name() const { return "Vertex BRDF: fit per-vertex reflectanc
 QString FitFilter::info() const {
   // Short on purpose: MeshLab 2020.09 puts this text above the fields, and a long one pushes Apply
   // off a 1000-pixel screen. The details are in docs/parameters.md and in each field's tooltip / Help.
-  return "Fits Phong reflectance (colour, k<sub>d</sub>, k<sub>s</sub>, shininess) to every vertex from the visible "
+  return "Fits reflectance (colour, k<sub>d</sub>, k<sub>s</sub>, shininess) to every vertex from the visible "
          "registered photos and their lights; colours the mesh with the albedo and writes a PLY with every "
          "per-vertex value and a report. Hover over a field, or press Help, for what it does.";
 }
@@ -82,7 +82,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
   shared::add_specular_threshold(params);
   shared::add_diffuse_threshold(params, shared::DiffuseThresholdUse::Fit);
   shared::add_photo_and_visibility(params);
-  params.addParam(RichBool(kFitReflectance, true, "Fit Phong reflectance",
+  params.addParam(RichBool(kFitReflectance, true, "Fit reflectance",
                            "Fit k_d, k_s, shininess and colour per vertex. Off: only the basic diffuse colour "
                            "(faster; kd/ks/shininess attributes are not written)."));
   params.addParam(RichEnum(kFitBackend, int(vbrdf::FitBackendChoice::Auto),
@@ -170,7 +170,7 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
   const int fit_backend = params.getEnum(kFitBackend);
   require(fit_backend >= 0 && fit_backend <= 2, kFitBackend, "must be 0 (Auto), 1 (GPU) or 2 (CPU)");
   const float alpha0 = params.getFloat(kInitialShininess);
-  require(alpha0 >= s.phong.alpha_min && alpha0 <= s.phong.alpha_max, kInitialShininess, "must be in [1, 2000]");
+  require(alpha0 >= s.reflectance.alpha_min && alpha0 <= s.reflectance.alpha_max, kInitialShininess, "must be in [1, 2000]");
   const int iterations = params.getInt(kMaxIterations);
   require(iterations >= 0 && iterations <= 10000, kMaxIterations, "must be in [0, 10000]");
   const int fill_rings = params.getInt(kFillUnseenRings);
@@ -183,11 +183,11 @@ vbrdf::FitSettings FitFilter::settings_from(const RichParameterList &params) {
 
   s.fit_reflectance = params.getBool(kFitReflectance);
   s.fit_backend = vbrdf::FitBackendChoice(fit_backend);
-  s.phong.alpha_init = alpha0;
-  s.phong.max_iterations = iterations;
-  s.phong.lobe = vbrdf::LobeForm(lobe);
+  s.reflectance.alpha_init = alpha0;
+  s.reflectance.max_iterations = iterations;
+  s.reflectance.lobe = vbrdf::LobeForm(lobe);
   s.diffuse_choice = vbrdf::DiffuseTermChoice(diffuse);
-  s.phong.min_specular_samples = shared::min_specular_samples(params);
+  s.reflectance.min_specular_samples = shared::min_specular_samples(params);
   s.fill_unseen_rings = fill_rings;
   s.materials = params.getBool(kFindMaterials);
   s.deconvolve_albedo = params.getBool(kSharpenAlbedo);
@@ -239,8 +239,8 @@ void FitFilter::apply(FilterRun &run) const {
     GlContextScope gl(needs_gl ? run.gl_context : nullptr, log);
     std::unique_ptr<vbrdf::VisibilityBackend> visibility = vbrdf::make_visibility_backend(
         input.mesh, settings.visibility_choice, settings.visibility, gl.get_proc(), log);
-    std::unique_ptr<vbrdf::PhongFitter> fitter;
-    if (settings.fit_reflectance) fitter = vbrdf::make_phong_fitter(settings.fit_backend, gl.get_proc(), log);
+    std::unique_ptr<vbrdf::ReflectanceFitter> fitter;
+    if (settings.fit_reflectance) fitter = vbrdf::make_reflectance_fitter(settings.fit_backend, gl.get_proc(), log);
     result = vbrdf::run_fit(input, settings, *visibility, fitter.get(), progress_adapter(run.progress, "Vertex BRDF: "),
                             log);
   }
@@ -257,7 +257,7 @@ void FitFilter::apply(FilterRun &run) const {
   std::ostringstream summary;
   summary << "Vertex BRDF: " << result.vertices_coloured << " of " << arrays.vertex_index.size()
           << " vertices coloured, " << result.vertices_unseen << " seen by no photo, " << result.vertices_no_diffuse
-          << " seen but without usable sample; " << result.fit_full << " full Phong fits, " << result.fit_diffuse_only
+          << " seen but without usable sample; " << result.fit_full << " full fits, " << result.fit_diffuse_only
           << " diffuse-only (visibility: " << result.visibility_backend << ", fit: "
           << (result.fit_backend.empty() ? std::string("off") : result.fit_backend) << ", lights: " << result.light_file
           << ", colour correction: " << color_summary(settings, result) << "). Wrote " << result.output_ply << " ("

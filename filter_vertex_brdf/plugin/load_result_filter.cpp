@@ -79,7 +79,7 @@ void LoadResultFilter::apply(FilterRun &run) const {
   log << ") from " << file << " to " << arrays.vertex_index.size() << " vertices (largest position difference "
       << attached.max_position_error << ").";
   if (attached.quality.empty())
-    log << " No Phong model in the file ('" << attached.missing_model_attribute << "' missing): quality unchanged.";
+    log << " No reflectance model in the file ('" << attached.missing_model_attribute << "' missing): quality unchanged.";
   else
     log << " Quality: "
         << (quality == vbrdf::QualityOutput::SQ ? "SQ" : quality == vbrdf::QualityOutput::RMSE ? "fit RMSE" : "DQ")

@@ -20,7 +20,7 @@ RelightModel relight_model(MeshModel &mesh) {
   const std::string missing = vbrdf::first_missing_model_attribute(columns);
   if (!missing.empty())
     throw vbrdf::InputError("Vertex BRDF relight: the mesh '" + name + "' has no per-vertex attribute '" + missing +
-                            "', so there is no Phong model to draw; MeshLab's normal rendering is shown. Run "
+                            "', so there is no reflectance model to draw; MeshLab's normal rendering is shown. Run "
                             "'Vertex BRDF: fit per-vertex reflectance' on it, or load its result PLY with "
                             "'Vertex BRDF: load result attributes'.");
   const std::vector<vbrdf::VertexRecord> records = vbrdf::records_from_columns(columns, "mesh '" + name + "'");

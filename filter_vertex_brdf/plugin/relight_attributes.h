@@ -1,6 +1,6 @@
 #pragma once
 // What the live view ("Vertex BRDF: relight", render_plugin/) needs from a MeshLab mesh: its
-// arrays and the per-vertex Phong model read from the mesh's float attributes by their schema
+// arrays and the per-vertex reflectance model read from the mesh's float attributes by their schema
 // names (kd, ks, shininess, color_r/g/b, fit_status, dq, sq, lobe_form, diffuse_form), as the fit
 // filter stores them and "Vertex BRDF: load result attributes" re-attaches them from a result PLY.
 // No GL here.
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/fit/phong_fit.h"
+#include "core/fit/reflectance_fit.h"
 #include "core/model/diffuse_form.h"
 #include "core/model/defaults.h"
 #include "core/model/lobe.h"

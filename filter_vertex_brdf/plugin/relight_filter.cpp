@@ -92,7 +92,7 @@ std::vector<vbrdf::VertexFit> fits_from_mesh(MeshModel &mesh, const MeshArrays &
   const std::string missing = vbrdf::first_missing_model_attribute(columns);
   if (!missing.empty())
     throw vbrdf::InputError("Mesh '" + utf8(mesh.label()) + "' has no per-vertex '" + missing +
-                            "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit Phong reflectance' on) "
+                            "': apply \"Vertex BRDF: fit per-vertex reflectance\" (with 'Fit reflectance' on) "
                             "first, or set 'fitResultPly' to the PLY it wrote.");
   std::vector<vbrdf::VertexFit> fits;
   const std::vector<vbrdf::VertexRecord> records = vbrdf::records_from_columns(columns, utf8(mesh.label()));
@@ -198,7 +198,7 @@ QString RelightFilter::name() const { return "Vertex BRDF: relight and compare";
 QString RelightFilter::info() const {
   // Short on purpose (see FitFilter::info); the details are in
   // docs/parameters.md#vertex-brdf-relight-and-compare and the tooltips.
-  return "Renders the fitted per-vertex Phong model (the attributes the fit stored, or its PLY) with OpenGL for "
+  return "Renders the fitted per-vertex reflectance model (the attributes the fit stored, or its PLY) with OpenGL for "
          "every raster's camera and light, or a novel view, and compares it with the photos: images, a contact "
          "sheet and a table of CIEDE2000 and PSNR in the output folder. The mesh is not changed. Hover over a "
          "field, or press Help, for what it does.";

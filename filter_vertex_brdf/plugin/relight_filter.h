@@ -1,5 +1,5 @@
 #pragma once
-// "Vertex BRDF: relight and compare": renders the fitted per-vertex Phong model (the attributes the
+// "Vertex BRDF: relight and compare": renders the fitted per-vertex reflectance model (the attributes the
 // fit filter stores on the mesh, or a saved result PLY) from every raster's camera under its light
 // and compares it with the photos (images, contact sheet, CSV table), and/or renders a novel
 // viewpoint under a light the user gives. The mesh is not changed.

@@ -1,6 +1,6 @@
 #pragma once
 // MeshLab 2020.09 render plugin "Vertex BRDF: relight" (Render > Shaders): draws the current mesh
-// with its per-vertex Phong model, lit by MeshLab's own light (Ctrl+Shift+drag). A thin adapter:
+// with its per-vertex reflectance model, lit by MeshLab's own light (Ctrl+Shift+drag). A thin adapter:
 // the model comes from the mesh's attributes (plugin/relight_attributes.h), the drawing from the
 // core (core/relight/live_relight.h), the view from GL state (gl_view_state.h), the controls from
 // relight_panel.h. Without a model it shows why and draws MeshLab's normal rendering.

@@ -1,4 +1,4 @@
-// bench_fit: time and accuracy of the per-vertex Phong fit (CPU reference vs GPU compute shader)
+// bench_fit: time and accuracy of the per-vertex reflectance fit (CPU reference vs GPU compute shader)
 // on synthetic samples with known parameters, for several iteration caps.
 //   bench_fit [--vertices 100000] [--photos 32] [--backend cpu|gpu|both] [--caps 1,2,5,10,20,50,400]
 //             [--noise 0.02] [--seed 1] [--csv file]
@@ -26,8 +26,8 @@
 
 #include "base/errors.h"
 #include "osmesa_context.h"
-#include "fit/phong_fit.h"
-#include "fit/phong_fit_gpu.h"
+#include "fit/reflectance_fit.h"
+#include "fit/reflectance_fit_gpu.h"
 #include "thesis_settings.h"
 
 using namespace vbrdf;
@@ -182,7 +182,7 @@ void score(const SampleChunk &chunk, const std::vector<Truth> &truth, const std:
       const Sample &s = chunk.samples[i];
       if (!usable(s)) continue;
       float fit[3], tru[3];
-      evaluate_phong(f, std::min(s.d, 1.0f), s.lobe_cos, LobeForm::PhongRE, fit);
+      evaluate_reflectance(f, std::min(s.d, 1.0f), s.lobe_cos, LobeForm::PhongRE, fit);
       true_model(t, std::min(s.d, 1.0f), s.lobe_cos, tru);
       for (int c = 0; c < 3; ++c) model_e += s.d * double(fit[c] - tru[c]) * double(fit[c] - tru[c]);
       model_w += 3 * s.d;
@@ -197,7 +197,7 @@ void score(const SampleChunk &chunk, const std::vector<Truth> &truth, const std:
   r.mean_iterations = chunk.vertex_count ? iterations / chunk.vertex_count : 0;
 }
 
-double time_fit(const std::string &backend, PhongFitGpu *gpu, const SampleChunk &chunk, const PhongFitOptions &o,
+double time_fit(const std::string &backend, ReflectanceFitGpu *gpu, const SampleChunk &chunk, const ReflectanceFitOptions &o,
                 std::vector<VertexFit> &out) {
   out.assign(chunk.vertex_count, VertexFit());
   const auto t0 = std::chrono::steady_clock::now();
@@ -271,13 +271,13 @@ int main(int argc, char **argv) {
   std::vector<std::string> backends;
   if (a.backend != "gpu") backends.push_back("cpu");
   std::unique_ptr<test::OsMesaContext> context;
-  std::unique_ptr<PhongFitGpu> gpu;
+  std::unique_ptr<ReflectanceFitGpu> gpu;
   if (a.backend != "cpu") {
     std::string why;
     context = test::OsMesaContext::try_create(&why);
     try {
       if (!context) throw ProcessingError("no OSMesa context: " + why);
-      gpu.reset(new PhongFitGpu(context->get_proc_address()));
+      gpu.reset(new ReflectanceFitGpu(context->get_proc_address()));
       std::printf("GPU: %s\n", gpu->device().c_str());
       std::vector<VertexFit> warm(std::min<uint32_t>(chunk.vertex_count, 256));
       SampleChunk head;  // first dispatch compiles the shader variant (llvmpipe JIT): not timed
@@ -305,7 +305,7 @@ int main(int argc, char **argv) {
   std::vector<VertexFit> fits;
   for (const std::string &b : backends)
     for (int cap : a.caps) {
-      PhongFitOptions o = vbrdf::test::thesis_fit_options();
+      ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
       o.max_iterations = cap;
       Row r;
       r.backend = b;

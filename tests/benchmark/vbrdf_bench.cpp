@@ -289,7 +289,7 @@ HeldOut load_heldout(const Args &a, const MeshData &mesh) {
 // every seen, lit, unsaturated vertex sample, the held-out photo sampled bilinearly at the
 // vertex's pixel, vertices without a model black) beside per-pixel PTM and Relight-style RBF fitted
 // on the training photos of the same camera and scored on the same samples (relight.h).
-// `lobe`, `diffuse`: the forms the fit used (FitSettings::phong.lobe, FitResult::diffuse_forms), and
+// `lobe`, `diffuse`: the forms the fit used (FitSettings::reflectance.lobe, FitResult::diffuse_forms), and
 // `deconvolved` its FitResult::albedo_deconvolved:
 // the renderer and the sample-based evaluation must evaluate the model the fit made.
 void evaluate_heldout(const Args &a, const MeshData &mesh, const std::vector<VertexFit> &fits, LobeForm lobe,
@@ -342,7 +342,7 @@ FitSettings settings_for(const Args &a, const std::string &work, const std::stri
     throw InputError("--backend must be gpu, cpu or cpu-all (got '" + backend + "')");
   s.fit_backend = backend == "gpu" ? FitBackendChoice::GPU : FitBackendChoice::CPU;
   s.visibility_choice = backend == "cpu-all" ? VisibilityChoice::CPU : VisibilityChoice::GL;
-  if (!a.get("iterations").empty()) s.phong.max_iterations = std::stoi(a.get("iterations"));  // else the filter's default
+  if (!a.get("iterations").empty()) s.reflectance.max_iterations = std::stoi(a.get("iterations"));  // else the filter's default
   const std::string materials = a.get("materials", s.materials ? "on" : "off");
   if (materials != "on" && materials != "off") throw InputError("--materials must be on or off (got '" + materials + "')");
   s.materials = materials == "on";
@@ -381,7 +381,7 @@ int cmd_fit(const Args &a) {
   const LogFn quiet = [](const std::string &) {};
   auto t = Clock::now();
   auto visibility = make_visibility_backend(input.mesh, settings.visibility_choice, settings.visibility, get_proc, quiet);
-  auto fitter = make_phong_fitter(settings.fit_backend, get_proc, quiet);
+  auto fitter = make_reflectance_fitter(settings.fit_backend, get_proc, quiet);
   const double t_init = since(t);
   t = Clock::now();
   const FitResult r = run_fit(input, settings, *visibility, fitter.get(), {}, quiet);
@@ -392,7 +392,7 @@ int cmd_fit(const Args &a) {
   out.num("vertices", double(mesh.positions.size() / 3));
   out.num("photos", double(project.rasters.size()));
   out.str("backend", a.get("backend", "gpu"));
-  out.num("iterations", settings.phong.max_iterations);
+  out.num("iterations", settings.reflectance.max_iterations);
   out.str("visibility_backend", r.visibility_backend);
   out.str("fit_backend", r.fit_backend);
   out.num("t_init", t_init);
@@ -411,7 +411,7 @@ int cmd_fit(const Args &a) {
   MeshData shaded = mesh;  // the model is evaluated with the normals it was fitted with (the PLY's nx ny nz)
   if (r.shading_normals.size() == shaded.normals.size()) shaded.normals = r.shading_normals;
   if (!a.get("heldout").empty())
-    evaluate_heldout(a, shaded, r.fits, settings.phong.lobe, r.diffuse_forms, r.albedo_deconvolved, input.rasters,
+    evaluate_heldout(a, shaded, r.fits, settings.reflectance.lobe, r.diffuse_forms, r.albedo_deconvolved, input.rasters,
                      resolve_lights(input.rasters, r.light_file,
                                     light_placement_of(mesh.view(), 0.0f, 0.0f)),
                      get_proc, out);

@@ -61,15 +61,15 @@ int main(int argc, char **argv) {
     else if (a == "--shadow-map") settings.visibility.shadow_map_size = std::stoi(next());
     else if (a == "--camera-divisor") settings.visibility.camera_pass_divisor = std::stoi(next());
     else if (a == "--depth-tests") settings.visibility.depth_tests_on_gpu = next() != "cpu";  // gpu (default) | cpu
-    else if (a == "--iterations") settings.phong.max_iterations = std::stoi(next());
-    else if (a == "--alpha0") settings.phong.alpha_init = std::stof(next());
-    else if (a == "--min-specular") settings.phong.min_specular_samples = std::stoi(next());
+    else if (a == "--iterations") settings.reflectance.max_iterations = std::stoi(next());
+    else if (a == "--alpha0") settings.reflectance.alpha_init = std::stof(next());
+    else if (a == "--min-specular") settings.reflectance.min_specular_samples = std::stoi(next());
     else if (a == "--photo-dir") photo_dir = next();
     else if (a == "--materials") settings.materials = next() == "on";
     else if (a == "--photo-shadows") settings.photo_shadows.enabled = next() == "on";
     else if (a == "--photo-memory-mb") settings.gather.photo_cache_bytes = size_t(std::stoull(next())) << 20;
     else if (a == "--lobe") {
-      if (!parse_lobe_form(next(), settings.phong.lobe)) return usage();
+      if (!parse_lobe_form(next(), settings.reflectance.lobe)) return usage();
     } else if (a == "--diffuse") {
       const std::string v = next();
       if (v == "auto") settings.diffuse_choice = DiffuseTermChoice::Auto;
@@ -102,10 +102,10 @@ int main(int argc, char **argv) {
       else return usage();
     }
     else if (a == "--no-remedies") {
-      settings.phong.specular_weight_cap = 1e30f;
-      settings.phong.diffuse_prior = 0;
-      settings.phong.min_specular_samples = 1;
-      settings.phong.min_lobe_samples = 1 << 30;
+      settings.reflectance.specular_weight_cap = 1e30f;
+      settings.reflectance.diffuse_prior = 0;
+      settings.reflectance.min_specular_samples = 1;
+      settings.reflectance.min_lobe_samples = 1 << 30;
     }
     else if (a == "--fit") {
       const std::string v = next();
@@ -147,9 +147,9 @@ int main(int argc, char **argv) {
       }
     }
     auto visibility = make_visibility_backend(input.mesh, settings.visibility_choice, settings.visibility, get_proc, log);
-    std::unique_ptr<PhongFitter> fitter;
+    std::unique_ptr<ReflectanceFitter> fitter;
     if (settings.fit_reflectance)
-      fitter = make_phong_fitter(settings.fit_backend, get_proc, log);
+      fitter = make_reflectance_fitter(settings.fit_backend, get_proc, log);
     run_fit(input, settings, *visibility, fitter.get(), {}, log);
     return 0;
   });

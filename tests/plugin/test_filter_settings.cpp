@@ -70,15 +70,15 @@ TEST(FitSettingsFrom, DefaultsAreTheCoresDefaults) {
   EXPECT_EQ(s.visibility.shadow_map_size, 0);  // automatic
   EXPECT_EQ(s.fit_reflectance, core.fit_reflectance);
   EXPECT_EQ(s.fit_backend, core.fit_backend);
-  EXPECT_FLOAT_EQ(s.phong.alpha_init, core.phong.alpha_init);
-  EXPECT_EQ(s.phong.lobe, vbrdf::kDefaultLobe);
-  EXPECT_EQ(s.phong.lobe, core.phong.lobe);
-  EXPECT_EQ(s.phong.lobe, vbrdf::PhongFitOptions().lobe);  // the core's structs on their own, too
-  EXPECT_EQ(s.phong.lobe, vbrdf::GatherSettings().lobe);
-  EXPECT_EQ(s.phong.lobe, vbrdf::RelightRenderSettings().lobe);
+  EXPECT_FLOAT_EQ(s.reflectance.alpha_init, core.reflectance.alpha_init);
+  EXPECT_EQ(s.reflectance.lobe, vbrdf::kDefaultLobe);
+  EXPECT_EQ(s.reflectance.lobe, core.reflectance.lobe);
+  EXPECT_EQ(s.reflectance.lobe, vbrdf::ReflectanceFitOptions().lobe);  // the core's structs on their own, too
+  EXPECT_EQ(s.reflectance.lobe, vbrdf::GatherSettings().lobe);
+  EXPECT_EQ(s.reflectance.lobe, vbrdf::RelightRenderSettings().lobe);
   EXPECT_EQ(s.diffuse_choice, vbrdf::kFitDiffuseChoice);
-  EXPECT_EQ(s.phong.max_iterations, core.phong.max_iterations);
-  EXPECT_EQ(s.phong.min_specular_samples, core.phong.min_specular_samples);
+  EXPECT_EQ(s.reflectance.max_iterations, core.reflectance.max_iterations);
+  EXPECT_EQ(s.reflectance.min_specular_samples, core.reflectance.min_specular_samples);
   EXPECT_EQ(s.fill_unseen_rings, core.fill_unseen_rings);
   EXPECT_EQ(s.materials, core.materials);
   EXPECT_EQ(s.deconvolve_albedo, core.deconvolve_albedo);
@@ -131,7 +131,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_FLOAT_EQ(s.gather.diffuse_threshold, 0.3f);
   EXPECT_EQ(s.gather.encoding, vbrdf::PhotoEncoding::Linear);
   EXPECT_FLOAT_EQ(s.gather.saturation_level, 0.95f);
-  EXPECT_EQ(s.phong.lobe, vbrdf::LobeForm::PhongRE);
+  EXPECT_EQ(s.reflectance.lobe, vbrdf::LobeForm::PhongRE);
   EXPECT_EQ(s.diffuse_choice, vbrdf::DiffuseTermChoice::Lambert);
   EXPECT_TRUE(s.materials);
   EXPECT_FALSE(s.deconvolve_albedo);
@@ -141,9 +141,9 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_EQ(s.visibility.shadow_map_size, 512);
   EXPECT_FALSE(s.fit_reflectance);
   EXPECT_EQ(s.fit_backend, vbrdf::FitBackendChoice::GPU);
-  EXPECT_FLOAT_EQ(s.phong.alpha_init, 20.0f);
-  EXPECT_EQ(s.phong.max_iterations, 7);
-  EXPECT_EQ(s.phong.min_specular_samples, 3);
+  EXPECT_FLOAT_EQ(s.reflectance.alpha_init, 20.0f);
+  EXPECT_EQ(s.reflectance.max_iterations, 7);
+  EXPECT_EQ(s.reflectance.min_specular_samples, 3);
   EXPECT_EQ(s.fill_unseen_rings, 4);
   EXPECT_EQ(s.quality, vbrdf::QualityOutput::RMSE);
   EXPECT_EQ(s.color_correction, vbrdf::ColorCorrectionChoice::Required);
@@ -182,8 +182,8 @@ TEST(FitSettingsFrom, OutOfRangeValuesNameTheirParameter) {
 TEST(CoverageSettingsFrom, DefaultsAgreeWithTheFit) {
   const vbrdf::CoverageSettings s = CoverageFilter::settings_from(defaults_of(CoverageFilter()));
   const vbrdf::FitSettings fit = FitFilter::settings_from(defaults_of(FitFilter()));
-  // "Fully covered" means what the fit needs for a Phong fit (the fit's minimum, not a lower one).
-  EXPECT_EQ(s.min_specular, fit.phong.min_specular_samples);
+  // "Fully covered" means what the fit needs for a reflectance fit (the fit's minimum, not a lower one).
+  EXPECT_EQ(s.min_specular, fit.reflectance.min_specular_samples);
   // 0 = automatic shadow map, in coverage as in the fit (and 0 is accepted there).
   EXPECT_EQ(s.visibility.shadow_map_size, fit.visibility.shadow_map_size);
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, fit.gather.specular_threshold);

@@ -4,7 +4,7 @@
 // test that exercises the thesis's model takes its settings from here, so that it keeps testing
 // what it was written for.
 #include "coverage/coverage_settings.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "relight/relight_render.h"
 #include "samples/samples.h"
 #include "tools/relight.h"
@@ -15,8 +15,8 @@ namespace test {
 constexpr LobeForm kThesisLobe = LobeForm::PhongRE;
 constexpr float kThesisDiffuseThreshold = 0.5f;
 
-inline PhongFitOptions thesis_fit_options() {
-  PhongFitOptions o;
+inline ReflectanceFitOptions thesis_fit_options() {
+  ReflectanceFitOptions o;
   o.lobe = kThesisLobe;
   return o;
 }

@@ -37,7 +37,7 @@ sys.dont_write_bytecode = True  # never write __pycache__ into the source tree
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
 import check_output  # noqa: E402
 
-# One small scene: enough lights and vertices for full Phong fits with well-determined k_s and
+# One small scene: enough lights and vertices for full fits with well-determined k_s and
 # alpha on the glossy regions, small enough to render and fit three times in well under a minute
 # on two cores.
 SCENE_ARGS = ["--vertices", "5000", "--width", "480", "--height", "360", "--lights", "48", "--ss", "1",

@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "samples/footprint.h"
 #include "model/lobe.h"
 #include "test_scenes.h"
@@ -114,7 +114,7 @@ TEST(Footprint, PlaneHasNoneAndASphereHasItsCurvature) {
 // curved vertex of bunny_two_materials_dir32 shows): fitted with the footprint, the surface's own
 // exponent and k_s come back; without it the fit reports the broader, lower lobe the photos show
 // (for one camera the same values at the vertex: a^2 + v and k_s a^2 / (a^2 + v)).
-TEST(PhongFit, RecoversTheSurfaceLobeThroughAFootprint) {
+TEST(ReflectanceFit, RecoversTheSurfaceLobeThroughAFootprint) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0, 1);
   const double alpha = 600, v = 0.003, ks = 0.8;
@@ -134,7 +134,7 @@ TEST(PhongFit, RecoversTheSurfaceLobeThroughAFootprint) {
     s.footprint = 0;
     without.push_back(s);
   }
-  PhongFitOptions o = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = LobeForm::GgxNH;
   o.alpha_max = 5000;
   VertexFit f_with, f_without;

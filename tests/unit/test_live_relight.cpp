@@ -1,6 +1,6 @@
 // Live relighting (live_relight.h), the render path of MeshLab's "Vertex BRDF: relight" plugin,
 // against the relight renderer (relight_render.h) for the same light and view: both evaluate
-// shaders/phong_model.glsl, so on every lit interior pixel of a convex object (no cast shadows,
+// shaders/reflectance_model.glsl, so on every lit interior pixel of a convex object (no cast shadows,
 // the one stated difference) they must agree within kTolerance. Controls with the other lobe form
 // and with every vertex's diffuse form swapped show that the comparison can fail. GL through
 // OSMesa; skipped when no context can be created.

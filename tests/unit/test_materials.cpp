@@ -80,7 +80,7 @@ struct StageRun {
 };
 
 StageRun run_stage(const Scene &sc, const MaterialOptions &mo = MaterialOptions(), LobeForm form = LobeForm::PhongRE) {
-  PhongFitOptions o = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = form;
   StageRun r;
   r.before.resize(sc.chunk.vertex_count);
@@ -251,7 +251,7 @@ TEST(Materials, NoSamplesLeaveTheFitsAlone) {
 // specular evidence: the stage keeps every vertex's own fit instead of stripping its lobe.
 TEST(Materials, WithoutAGlossyMaterialOwnLobesAreKept) {
   const Scene sc = make_scene(false, 0.0f, 30.0f, 5);  // a matte object
-  PhongFitOptions o = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = LobeForm::GgxNH;
   std::vector<VertexFit> before(sc.chunk.vertex_count);
   fit_chunk_cpu(sc.chunk, o, before.data());

@@ -1,4 +1,4 @@
-// The GLSL copies of the model (shaders/phong_model.glsl, shaders/phong_fit.comp) against the C++
+// The GLSL copies of the model (shaders/reflectance_model.glsl, shaders/reflectance_fit.comp) against the C++
 // model (core/model/): every constant a shader names at file scope has its C++ value, each shader
 // names it once, and no shader writes one of those values as a bare literal elsewhere, so that a
 // change of the model's constant cannot leave a shader behind.
@@ -108,11 +108,11 @@ void check_shader(const std::string &name, const std::vector<std::string> &requi
 } // namespace
 
 TEST(ModelConstants, TheRelightModelShaderNamesTheModelsConstants) {
-  check_shader("phong_model.glsl", {"kMaxFootprintVariance", "kLobeLogFloor"});
+  check_shader("reflectance_model.glsl", {"kMaxFootprintVariance", "kLobeLogFloor"});
 }
 
 TEST(ModelConstants, TheFitShaderNamesTheModelsConstants) {
-  check_shader("phong_fit.comp", {"kMaxFootprintVariance", "kLobeLogFloor", "kUnusable", "kStatusDiffuseOnly",
+  check_shader("reflectance_fit.comp", {"kMaxFootprintVariance", "kLobeLogFloor", "kUnusable", "kStatusDiffuseOnly",
                                   "kStatusFull"});
 }
 

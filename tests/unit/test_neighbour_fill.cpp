@@ -1,4 +1,4 @@
-// Neighbour fill (neighbour_fill.h) and the weak-sample fallback fit (phong_fit.h): every seen
+// Neighbour fill (neighbour_fill.h) and the weak-sample fallback fit (reflectance_fit.h): every seen
 // vertex gets a model; unseen ones only on request.
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include "base/mesh_adjacency.h"
 #include "fit/label_spread.h"
 #include "fit/neighbour_fill.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "test_scenes.h"
 #include "thesis_settings.h"
 

@@ -4,7 +4,7 @@
 #include <random>
 
 #include "fit/photo_shadows.h"
-#include "phong_test_util.h"
+#include "reflectance_test_util.h"
 #include "thesis_settings.h"
 
 namespace vbrdf {
@@ -13,7 +13,7 @@ namespace {
 // Lambertian samples of rho = (0.5, 0.4, 0.3) with d in [0.5, 1] (none grazing), 1 % noise; the
 // first `dark` of them photographed in a shadow the mesh does not cast (5 % of their light).
 std::vector<Sample> lit_samples(int n, int dark, std::mt19937 &rng) {
-  const test::TruePhong truth{{0.5f, 0.4f, 0.3f}, 0.0f, 10.0f};
+  const test::TrueReflectance truth{{0.5f, 0.4f, 0.3f}, 0.0f, 10.0f};
   std::vector<Sample> s = test::synth_samples(truth, n, 0.01f, rng, 0);
   std::uniform_real_distribution<float> u(0.5f, 1.0f);
   for (int i = 0; i < n; ++i) {
@@ -43,7 +43,7 @@ float rho_error(const VertexFit &f) {
 TEST(PhotoShadows, DarkSamplesAreLeftOutAndTheVertexRefitted) {
   std::mt19937 rng(7);
   SampleChunk chunk = one_vertex(lit_samples(12, 3, rng));
-  const PhongFitOptions options = vbrdf::test::thesis_fit_options();
+  const ReflectanceFitOptions options = vbrdf::test::thesis_fit_options();
   VertexFit fit;
   fit_vertex_cpu(chunk.samples.data(), chunk.samples.size(), options, fit);
   const float before = rho_error(fit);
@@ -75,7 +75,7 @@ TEST(PhotoShadows, OffChangesNothing) {
 
 TEST(PhotoShadows, SafeguardsKeepMostSamplesAndEnoughOfThem) {
   std::mt19937 rng(11);
-  const PhongFitOptions options = vbrdf::test::thesis_fit_options();
+  const ReflectanceFitOptions options = vbrdf::test::thesis_fit_options();
   // More than half dark: the "shadow" is the vertex's own colour, nothing is flagged.
   std::vector<Sample> most_dark = lit_samples(12, 7, rng);
   VertexFit fit;

@@ -36,7 +36,7 @@ std::unique_ptr<test::OsMesaContext> context_or_skip(std::string &why) {
   auto ctx = context_or_skip(why_);                       \
   if (!ctx) GTEST_SKIP() << "no OSMesa context: " << why_
 
-VertexFit phong_fit(const float rho[3], float ks, float shininess) {
+VertexFit reflectance_fit(const float rho[3], float ks, float shininess) {
   VertexFit f{};
   f.kd = std::max(rho[0], std::max(rho[1], rho[2]));
   for (int c = 0; c < 3; ++c) f.color[c] = f.kd > 0 ? rho[c] / f.kd : 0;
@@ -69,7 +69,7 @@ size_t count_class(const RelitImage &r, uint8_t cls) {
 const float *pixel(const RelitImage &r, int x, int y) { return &r.rgb[3 * (size_t(y) * size_t(r.width) + size_t(x))]; }
 uint8_t pixel_class(const RelitImage &r, int x, int y) { return r.pixel_class[size_t(y) * size_t(r.width) + size_t(x)]; }
 
-// Renders the lit plane y = 0 (uniform Phong fit) from top_camera() under `light` and compares
+// Renders the lit plane y = 0 (uniform reflectance fit) from top_camera() under `light` and compares
 // every third pixel with the model evaluated at the pixel's plane point: the light's direction and
 // irradiance there (light_source.h, as the CPU computes them).
 struct PlaneCheck {
@@ -88,7 +88,7 @@ PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
     settings.diffuse = DiffuseForms{DiffuseForm::Lambert, coated};
   }
   const float rho[3] = {0.5f, 0.3f, 0.1f};
-  const std::vector<VertexFit> fits(mesh.positions.size() / 3, phong_fit(rho, 0.4f, 30.0f));
+  const std::vector<VertexFit> fits(mesh.positions.size() / 3, reflectance_fit(rho, 0.4f, 30.0f));
   RelightRenderer renderer(mesh.view(), fits, ctx.get_proc_address(), settings);
   const Shot shot = top_camera();
   const RelitImage r = renderer.render(shot, light);
@@ -112,7 +112,7 @@ PlaneCheck render_plane(test::OsMesaContext &ctx, const LightSource &light,
       const DiffuseForm form = coat_map ? (p[0] < 0 ? DiffuseForm::Coated : DiffuseForm::Lambert) : settings.diffuse.uniform;
       const float nf[3] = {n[0], n[1], n[2]}, lf[3] = {lv[0], lv[1], lv[2]}, ef[3] = {e[0], e[1], e[2]};
       const float cosine = settings.lobe == LobeForm::PhongRE ? refl * e : lobe_cosine(settings.lobe, nf, lf, ef);
-      evaluate_phong(fits[0], diffuse_factor(form, d, n * e), cosine, settings.lobe, expected);
+      evaluate_reflectance(fits[0], diffuse_factor(form, d, n * e), cosine, settings.lobe, expected);
       const float irradiance = light_irradiance_at(light, pf);
       for (int k = 0; k < 3; ++k)
         c.worst = std::max(c.worst, double(std::fabs(pixel(r, x, y)[k] - expected[k] * irradiance)));
@@ -194,7 +194,7 @@ TEST(RelightRender, CastShadowsAndUnfittedVertices) {
   test::append_mesh(mesh, test::make_grid(4, 0.3f, 1.0f));
   const size_t n = mesh.positions.size() / 3;
   const float grey[3] = {0.5f, 0.5f, 0.5f};
-  std::vector<VertexFit> fits(n, phong_fit(grey, 0, 0));
+  std::vector<VertexFit> fits(n, reflectance_fit(grey, 0, 0));
   // The ground's far corner (x, z > 1.5) has no fit.
   for (size_t v = 0; v < 41 * 41; ++v)
     if (mesh.positions[3 * v] > 1.5f && mesh.positions[3 * v + 2] > 1.5f) fits[v] = VertexFit{};
@@ -253,7 +253,7 @@ struct FlatScene {
                                                uint16_t(photo_rho[0] * 65535));
       }
     cv::imwrite(raster.image_path, img);
-    fits.assign(mesh.positions.size() / 3, phong_fit(model_rho, 0, 0));
+    fits.assign(mesh.positions.size() / 3, reflectance_fit(model_rho, 0, 0));
   }
 };
 

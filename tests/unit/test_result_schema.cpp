@@ -69,7 +69,7 @@ TEST(ResultSchema, FileFormatIsTheDocumentedOne) {
   std::vector<std::string> names = vertex_property_names(dir + "/full.ply");
   ASSERT_GE(names.size(), 10u);
   EXPECT_EQ(std::vector<std::string>(names.begin() + 10, names.end()), expected);
-  // Without the Phong fit: only the first seven.
+  // Without the reflectance fit: only the first seven.
   write_result_ply(dir + "/basic.ply", mesh.view(), std::vector<uint8_t>(4 * n, 9), result_attributes(records, false));
   names = vertex_property_names(dir + "/basic.ply");
   ASSERT_GE(names.size(), 10u);

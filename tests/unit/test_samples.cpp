@@ -426,7 +426,7 @@ TEST(Samples, GatherTakesEachVertexsDiffuseForm) {
   EXPECT_EQ(checked, 100);
 }
 
-// shaders/phong_fit.comp reads a sample's last word as raster | flags << 16 | resolution << 26.
+// shaders/reflectance_fit.comp reads a sample's last word as raster | flags << 16 | resolution << 26.
 TEST(Samples, SampleWordMatchesTheShader) {
   Sample s{};
   s.raster = 0x1234;

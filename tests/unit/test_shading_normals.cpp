@@ -10,7 +10,7 @@
 
 #include "base/mesh_adjacency.h"
 #include "base/vec3.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "fit/shading_normals.h"
 #include "samples/reshade.h"
 #include "test_scenes.h"
@@ -88,7 +88,7 @@ SampleChunk gather(const NormalCapture &c) {
         const float *l = c.lights[k].direction.data();
         Sample truth{}, s{};
         shade_sample(&c.truth[3 * v], l, e, DiffuseForm::Lambert, c.gather, truth);
-        evaluate_phong(c.model, truth.d, truth.lobe_cos, LobeForm::GgxNH, s.rgb);
+        evaluate_reflectance(c.model, truth.d, truth.lobe_cos, LobeForm::GgxNH, s.rgb);
         s.raster = uint16_t(k);
         shade_sample(&c.mesh.normals[3 * v], l, e, DiffuseForm::Lambert, c.gather, s);
         if (truth.d <= 0) s.flags |= kCastShadow;  // the surface's own shadow: dark, and the mesh's test says so
@@ -99,8 +99,8 @@ SampleChunk gather(const NormalCapture &c) {
   return chunk;
 }
 
-PhongFitOptions fit_options() {
-  PhongFitOptions o = vbrdf::test::thesis_fit_options();
+ReflectanceFitOptions fit_options() {
+  ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   o.lobe = LobeForm::GgxNH;
   return o;
 }

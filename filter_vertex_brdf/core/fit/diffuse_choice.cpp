@@ -56,7 +56,7 @@ struct PilotVertex {
 
 std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Raster> &rasters,
                                     const std::vector<LightSource> &lights, const VisibilityMasks &pilot,
-                                    GatherSettings gather, DiffuseForm form, const PhongFitOptions &phong,
+                                    GatherSettings gather, DiffuseForm form, const ReflectanceFitOptions &phong,
                                     PhotoCache &photos, const std::function<void(SampleChunk &)> &prepare) {
   gather.diffuse = DiffuseForms::everywhere(form);
   gather.resolution_weights = false;
@@ -91,7 +91,7 @@ std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Rast
           for (const Sample *s = begin; s != end; ++s) {
             if (!held_out_in_fold(s->raster, k) || !scorable(*s)) continue;
             float predicted[3];
-            evaluate_phong(fit, s->d, s->lobe_cos, phong.lobe, predicted, s->footprint);
+            evaluate_reflectance(fit, s->d, s->lobe_cos, phong.lobe, predicted, s->footprint);
             for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;
             ++p.samples;
           }
@@ -157,7 +157,7 @@ std::string format_error(double e) { return three_significant(e); }
 
 DiffuseChoice choose_diffuse_forms(const MeshView &mesh, const std::vector<Raster> &rasters,
                                    const std::vector<LightSource> &lights, const VisibilityMasks &masks,
-                                   const GatherSettings &gather, const PhongFitOptions &phong, PhotoCache &photos,
+                                   const GatherSettings &gather, const ReflectanceFitOptions &phong, PhotoCache &photos,
                                    const std::function<void(SampleChunk &)> &prepare,
                                    const DiffuseChoiceOptions &options) {
   const auto start = std::chrono::steady_clock::now();

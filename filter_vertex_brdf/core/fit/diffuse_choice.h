@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "fit/heldout_folds.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
 #include "inputs/photo.h"
@@ -61,7 +61,7 @@ struct DiffuseChoiceOptions {
 
 DiffuseChoice choose_diffuse_forms(const MeshView &mesh, const std::vector<Raster> &rasters,
                                    const std::vector<LightSource> &lights, const VisibilityMasks &masks,
-                                   const GatherSettings &gather, const PhongFitOptions &phong, PhotoCache &photos,
+                                   const GatherSettings &gather, const ReflectanceFitOptions &phong, PhotoCache &photos,
                                    const std::function<void(SampleChunk &)> &prepare,
                                    const DiffuseChoiceOptions &options = DiffuseChoiceOptions());
 

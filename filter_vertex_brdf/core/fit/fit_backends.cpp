@@ -4,7 +4,7 @@
 #include <cctype>
 
 #include "base/errors.h"
-#include "fit/phong_fit_gpu.h"
+#include "fit/reflectance_fit_gpu.h"
 #include "visibility/visibility_gl.h"
 
 namespace vbrdf {
@@ -38,12 +38,12 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const MeshView &mesh,
 
 namespace {
 
-class CpuFitter : public PhongFitter {
+class CpuFitter : public ReflectanceFitter {
 public:
   // `why`: how it came to be chosen, appended to the name (the report shows it).
   explicit CpuFitter(const std::string &why = "") : name_("CPU (double, OpenMP)" + (why.empty() ? "" : "; " + why)) {}
   const char *name() const override { return name_.c_str(); }
-  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
+  void fit_chunk(const SampleChunk &chunk, const ReflectanceFitOptions &o, VertexFit *out) override {
     fit_chunk_cpu(chunk, o, out);
   }
 
@@ -51,17 +51,17 @@ private:
   std::string name_;
 };
 
-class GpuFitter : public PhongFitter {
+class GpuFitter : public ReflectanceFitter {
 public:
   explicit GpuFitter(const GetProcAddressFn &get_proc) : gpu_(get_proc), name_("GPU compute shader, " + gpu_.device()) {}
   const char *name() const override { return name_.c_str(); }
   std::string device() const { return gpu_.device(); }
-  void fit_chunk(const SampleChunk &chunk, const PhongFitOptions &o, VertexFit *out) override {
+  void fit_chunk(const SampleChunk &chunk, const ReflectanceFitOptions &o, VertexFit *out) override {
     gpu_.fit_chunk(chunk, o, out);
   }
 
 private:
-  PhongFitGpu gpu_;
+  ReflectanceFitGpu gpu_;
   std::string name_;
 };
 
@@ -80,33 +80,33 @@ bool is_software_renderer(const std::string &gl_renderer) {
 } // namespace
 
 
-std::unique_ptr<PhongFitter> make_phong_fitter(FitBackendChoice choice, const GetProcAddressFn &get_proc,
+std::unique_ptr<ReflectanceFitter> make_reflectance_fitter(FitBackendChoice choice, const GetProcAddressFn &get_proc,
                                                const LogFn &log) {
   if (choice != FitBackendChoice::CPU) {
     if (get_proc) {
       try {
         std::unique_ptr<GpuFitter> gpu(new GpuFitter(get_proc));
         if (choice == FitBackendChoice::Auto && is_software_renderer(gpu->device())) {
-          std::unique_ptr<PhongFitter> cpu(new CpuFitter(
+          std::unique_ptr<ReflectanceFitter> cpu(new CpuFitter(
               "Auto chose it over the compute shader: the GL context is a software renderer (" + gpu->device() + ")"));
-          log(std::string("Phong fit: ") + cpu->name() + ". Set 'Fit back end' to GPU to use the shader anyway.");
+          log(std::string("Reflectance fit: ") + cpu->name() + ". Set 'Fit back end' to GPU to use the shader anyway.");
           return cpu;
         }
-        log(std::string("Phong fit: ") + gpu->name() + ".");
-        return std::unique_ptr<PhongFitter>(gpu.release());
+        log(std::string("Reflectance fit: ") + gpu->name() + ".");
+        return std::unique_ptr<ReflectanceFitter>(gpu.release());
       } catch (const ProcessingError &e) {
         if (choice == FitBackendChoice::GPU)
           throw ProcessingError(std::string("'Fit back end' is set to GPU (compute shader), but ") + e.what() +
                                 " Set 'Fit back end' to Auto or CPU (reference).");
-        log(std::string("Phong fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");
+        log(std::string("Reflectance fit: GPU back end unavailable (") + e.what() + "); using the CPU reference.");
       }
     } else if (choice == FitBackendChoice::GPU) {
       throw ProcessingError("'Fit back end' is set to GPU (compute shader), but no GL context is available: set "
                             "'Fit back end' to Auto or CPU (reference).");
     }
   }
-  std::unique_ptr<PhongFitter> cpu(new CpuFitter());
-  log(std::string("Phong fit: ") + cpu->name() + ".");
+  std::unique_ptr<ReflectanceFitter> cpu(new CpuFitter());
+  log(std::string("Reflectance fit: ") + cpu->name() + ".");
   return cpu;
 }
 

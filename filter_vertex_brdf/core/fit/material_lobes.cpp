@@ -7,7 +7,7 @@
 namespace vbrdf {
 namespace material_stage {
 
-std::vector<double> alpha_grid(const PhongFitOptions &o) {
+std::vector<double> alpha_grid(const ReflectanceFitOptions &o) {
   const double lo = std::max(1.0, double(o.alpha_min)), hi = std::max(double(o.alpha_max), 2 * lo);
   std::vector<double> g;
   for (int j = 0;; ++j) {

@@ -17,7 +17,7 @@ struct LobeFit {
 // sample's lobe at every grid alpha costs three exponentials and squarings: s^(2a) = (s^a)^2), the
 // last point alpha_max.
 constexpr int kGridStepsPerDoubling = 3;
-std::vector<double> alpha_grid(const PhongFitOptions &o);
+std::vector<double> alpha_grid(const ReflectanceFitOptions &o);
 
 // Pooled lobes of materials 1..K (label[v]) on `set`: alpha over a log grid (on grid_labels'
 // subsample) with parabolic refinement in ln alpha, k_s in closed form (rho eliminated per vertex);

@@ -9,7 +9,7 @@ MaterialSampleStore::MaterialSampleStore(size_t vertex_count)
     : begin_(vertex_count, 0), end_(vertex_count, 0), grazing_begin_(vertex_count, 0), grazing_end_(vertex_count, 0) {}
 
 namespace {
-// The fit's usable-sample rules (phong_fit_cpu.cpp usable_samples), strict or weak.
+// The fit's usable-sample rules (reflectance_fit_cpu.cpp usable_samples), strict or weak.
 bool kept_sample(const Sample &s, bool weak) {
   if ((s.flags & (kShadowed | kSaturated | kNotSeen)) || !(s.d > 0)) return false;
   if ((s.flags & kMixedPixel) && !weak) return false;
@@ -28,7 +28,7 @@ MaterialSampleStore::Entry entry_of(const Sample &s, float w) {
 }
 } // namespace
 
-void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o) {
+void MaterialSampleStore::add_chunk(const SampleChunk &chunk, const VertexFit *fits, const ReflectanceFitOptions &o) {
   // Counted first, so that the store grows once per chunk (geometrically) rather than by doubling
   // copies of tens of MB as entries are pushed.
   const uint32_t count = std::min<uint64_t>(chunk.vertex_count, begin_.size() - std::min<uint64_t>(begin_.size(), chunk.first_vertex));

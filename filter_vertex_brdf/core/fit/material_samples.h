@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "samples/samples.h"
 
 namespace vbrdf {
@@ -17,7 +17,7 @@ public:
   explicit MaterialSampleStore(size_t vertex_count = 0);
   // Keeps the usable samples of the chunk's vertices; `fits` are the chunk's fits (their status
   // picks the strict or the weak sample rules). Call once per chunk, before or after the fit.
-  void add_chunk(const SampleChunk &chunk, const VertexFit *fits, const PhongFitOptions &o);
+  void add_chunk(const SampleChunk &chunk, const VertexFit *fits, const ReflectanceFitOptions &o);
   struct Entry {
     float rgb[3];
     float d, s, w;      // N.L, the lobe's cosine (R.E or N.H), weight (resolution weight included)

@@ -33,7 +33,7 @@ struct Lobe {
 
 struct Context {
   const MaterialSampleStore &store;
-  const PhongFitOptions &o;
+  const ReflectanceFitOptions &o;
   const MaterialOptions &mo;
   // Per entry, the lobe's key x (lobe_key): +1 for s <= 0 (no lobe); else ln(min(s, 1)) for the
   // power forms, -(1 - s^2) for GGX (both <= 0).
@@ -119,7 +119,7 @@ inline Lobe lobe_from_sums(const double *sums, size_t stride, size_t i) {
 }
 
 // Pooled k_s from summed k_s equations (num = sum rhs, den = sum info), in [0, ks_max]; 0 without information.
-inline double pooled_ks(double num, double den, const PhongFitOptions &o) {
+inline double pooled_ks(double num, double den, const ReflectanceFitOptions &o) {
   return den > 0 ? std::min(std::max(num / den, 0.0), double(o.ks_max)) : 0.0;
 }
 

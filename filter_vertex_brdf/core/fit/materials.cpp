@@ -277,7 +277,7 @@ void count_members(const Context &c, const std::vector<Static> &S, const std::ve
 void rewrite_fits(const Context &c, const std::vector<Static> &S, const Config &fin, const std::vector<uint8_t> &diffuse,
                   const std::vector<uint8_t> &rewritten, const Params &P, const float *diffuse_rgb,
                   const uint8_t *diffuse_valid, std::vector<VertexFit> &fits, MaterialResult &R) {
-  const PhongFitOptions &o = c.o;
+  const ReflectanceFitOptions &o = c.o;
   uint64_t to_specular = 0, to_diffuse = 0;
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : to_specular, to_diffuse) if (c.n > 20000)
   for (long long vi = 0; vi < (long long)c.n; ++vi) {
@@ -327,7 +327,7 @@ void describe_materials(const Config &fin, const std::vector<uint8_t> &diffuse, 
 
 // The context of the stage: the vertices it refits (eligible: fitted from their own samples, with
 // samples kept) and the lobe keys of the kept samples.
-Context stage_context(const MeshView &mesh, const MaterialSampleStore &store, const PhongFitOptions &o,
+Context stage_context(const MeshView &mesh, const MaterialSampleStore &store, const ReflectanceFitOptions &o,
                       const MaterialOptions &mo, const std::vector<VertexFit> &fits) {
   Context c{store, o, mo, {}, {}, {}, std::min(mesh.vertex_count, std::min(store.vertex_count(), fits.size()))};
   c.eligible.assign(c.n, 0);
@@ -346,7 +346,7 @@ double seconds_from(std::chrono::steady_clock::time_point t0) {
 
 } // namespace
 
-MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &store, const PhongFitOptions &o,
+MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &store, const ReflectanceFitOptions &o,
                              const MaterialOptions &mo, const float *diffuse_rgb, const uint8_t *diffuse_valid,
                              std::vector<VertexFit> &fits) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -1,7 +1,7 @@
 #pragma once
 // Material stage: materials found from the data, and a specular lobe per material.
 //
-// After the per-vertex Phong fit, the modelled vertices are grouped into a few materials by their
+// After the per-vertex reflectance fit, the modelled vertices are grouped into a few materials by their
 // specular response, a lobe (k_s, alpha on the fit's lobe cosine, R.E or N.H) is fitted per material from the pooled samples of
 // all its vertices, and the vertices of a glossy material get a specular term. A vertex whose own
 // fit found a lobe (fit_status 2, k_s > 0) keeps it (MaterialOptions::keep_full_fits, default);
@@ -37,7 +37,7 @@
 // crosses material boundaries (spot: one coating over a textured albedo; bunny: colour bands cross
 // the glossy/diffuse split), and the held-out criterion judges the specular model only.
 //
-// Samples: the fit's usable samples (phong_fit.h rules: lit, unsaturated, clean, N.L > 0, not
+// Samples: the fit's usable samples (reflectance_fit.h rules: lit, unsaturated, clean, N.L > 0, not
 // grazing unless a highlight; for fit_status 4 vertices the weak rules: grazing kept, mixed
 // pixels at mixed_sample_weight) are kept per vertex while the chunks stream (28 bytes each; the
 // report states the memory). Weights w = N.L as in the fit. Double precision, CPU, for either fit
@@ -50,7 +50,7 @@
 #include "base/mesh_view.h"
 #include "fit/heldout_folds.h"
 #include "fit/material_samples.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "samples/samples.h"
 
 namespace vbrdf {
@@ -154,7 +154,7 @@ struct MaterialResult {
 // validity flag per vertex in `diffuse_valid`, used for vertices of diffuse materials.
 // Vertices with status kFitNone or kFitFromNeighbours are not refitted (the caller fills them later
 // and labels them with propagate_material_labels).
-MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &store, const PhongFitOptions &o,
+MaterialResult fit_materials(const MeshView &mesh, const MaterialSampleStore &store, const ReflectanceFitOptions &o,
                              const MaterialOptions &mo, const float *diffuse_rgb, const uint8_t *diffuse_valid,
                              std::vector<VertexFit> &fits);
 

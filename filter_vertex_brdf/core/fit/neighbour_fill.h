@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 
 namespace vbrdf {
 

@@ -35,7 +35,7 @@ size_t flag_photo_shadows(const VertexFit &fit, Sample *samples, size_t count, c
   return dark.size();
 }
 
-void refit_photo_shadows(SampleChunk &chunk, const PhongFitOptions &options, const PhotoShadowSettings &settings,
+void refit_photo_shadows(SampleChunk &chunk, const ReflectanceFitOptions &options, const PhotoShadowSettings &settings,
                          VertexFit *fits, size_t &flagged_samples, size_t &refitted_vertices) {
   if (!settings.enabled) return;
   size_t flagged = 0, refitted = 0;

@@ -10,7 +10,7 @@
 // leaving fewer than kPhotoShadowMinRemaining; one pass.
 #include <cstddef>
 
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "samples/samples.h"
 
 namespace vbrdf {
@@ -34,7 +34,7 @@ size_t flag_photo_shadows(const VertexFit &fit, Sample *samples, size_t count, c
 // that had any, with the CPU reference (fit_vertex_cpu; the fallback rules of fit_vertex_weak for
 // fit_status 4, or when the strict rules find nothing left). `fits` has one entry per chunk vertex.
 // Adds the flagged samples and refitted vertices to the counters.
-void refit_photo_shadows(SampleChunk &chunk, const PhongFitOptions &options, const PhotoShadowSettings &settings,
+void refit_photo_shadows(SampleChunk &chunk, const ReflectanceFitOptions &options, const PhotoShadowSettings &settings,
                          VertexFit *fits, size_t &flagged_samples, size_t &refitted_vertices);
 
 } // namespace vbrdf

@@ -8,7 +8,7 @@
 // Per vertex (the chunk's vertices with a model fitted from their own samples, fit_status 1 or 2):
 //   minimise  sum_i w_i rho(|P_i - f(n; L_i, E_i)| / sigma) + |x|^2 / sigma_m^2
 //   over n = normalise(n_mesh + x_1 t_1 + x_2 t_2) (t_1, t_2: the mesh normal's tangent plane),
-//   f the vertex's model (phong_fit.h) with its fitted shininess held and k_d C and k_s solved in
+//   f the vertex's model (reflectance_fit.h) with its fitted shininess held and k_d C and k_s solved in
 //   closed form at each trial normal (variable projection: brightness and tilt trade against each
 //   other, so solving them together converges where alternating crawls), w_i the sample's
 //   resolution weight, rho Huber at 2 sigma, sigma the samples' residual per channel at the
@@ -33,7 +33,7 @@
 
 #include "base/mesh_adjacency.h"
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "inputs/light_source.h"
 #include "inputs/photo.h"
 #include "samples/samples.h"

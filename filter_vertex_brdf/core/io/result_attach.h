@@ -19,7 +19,7 @@ struct AttachedResult {
   std::vector<VertexAttribute> attributes;  // every schema attribute the file has, in table order
   std::vector<uint8_t> colors_rgba;         // the file's display colours (empty when it has none)
   std::vector<float> quality;               // as FitSettings::quality, neutral where unmodelled;
-                                            // empty when the file has no Phong model
+                                            // empty when the file has no reflectance model
   std::string missing_model_attribute;      // why quality is empty ("" otherwise)
   size_t modelled = 0;                      // vertices with fit_status != 0
   float max_position_error = 0.0f;          // largest vertex distance found (mesh units)

@@ -119,7 +119,7 @@ std::vector<VertexFit> fits_from_result(const ResultPly &result, const std::stri
   const std::string missing = first_missing_model_attribute(result.vertex_properties);
   if (!missing.empty())
     throw InputError("Result '" + path + "' has no per-vertex '" + missing +
-                     "': run the fit with 'Fit Phong reflectance' on first.");
+                     "': run the fit with 'Fit reflectance' on first.");
   std::vector<VertexFit> fits;
   const std::vector<VertexRecord> records = records_from_columns(result.vertex_properties, path);
   for (const VertexRecord &record : records) fits.push_back(record.fit);

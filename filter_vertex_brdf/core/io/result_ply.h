@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 
 namespace vbrdf {
 
@@ -22,7 +22,7 @@ struct ResultPly {
 ResultPly read_result_ply(const std::string &path);
 
 // Per-vertex fits from the properties named in the result schema (result_schema.h), by name:
-// every Phong attribute present is read (dq, sq, fit_rmse and fit_iterations may be absent: 0).
+// every model attribute present is read (dq, sq, fit_rmse and fit_iterations may be absent: 0).
 // Throws InputError naming the first missing attribute needed for the model (kd, ks, shininess,
 // color_r/g/b, fit_status), or a column of the wrong length.
 // `lobe` and `diffuse` (optional) receive the result's lobe and diffuse forms (lobe_form_of,

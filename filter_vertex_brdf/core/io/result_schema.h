@@ -4,7 +4,7 @@
 // readers go through this table by name, never by position, so reordering or adding an entry
 // cannot feed one attribute's values to another.
 //
-// File order is the table's order (diffuse_r ... coloured, then the Phong fit's kd ...
+// File order is the table's order (diffuse_r ... coloured, then the reflectance fit's kd ...
 // fit_iterations); keep it: existing result files, tools and the README table (README.md#output)
 // follow it.
 // Every attribute is stored as a 32-bit float.
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "io/output_ply.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 
 namespace vbrdf {
 
@@ -31,14 +31,14 @@ struct VertexRecord {
   VertexFit fit = {{0.0f, 0.0f, 0.0f}, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0, kFitNone, 0};  // sentinels
 };
 
-enum class AttributeGroup { Always, PhongFit };  // PhongFit: stored only when the Phong fit ran
+enum class AttributeGroup { Always, ReflectanceFit };  // ReflectanceFit: stored only when the reflectance fit ran
 enum class AttributeKind { Real, Count, Code };   // what the float holds (Count, Code: whole numbers)
 
 struct ResultAttribute {
   const char *name;       // PLY property and MeshLab per-vertex attribute name
   AttributeKind kind;
   AttributeGroup group;
-  bool needed_for_model;  // a reader cannot rebuild the Phong model without it
+  bool needed_for_model;  // a reader cannot rebuild the reflectance model without it
   const char *meaning;    // one line, as in the README's output table
   float (*get)(const VertexRecord &);
   void (*set)(VertexRecord &, float);  // from a stored value; whole-number fields are clamped
@@ -54,7 +54,7 @@ const ResultAttribute *find_result_attribute(const std::string &name);
 // The names of the table, in file order, separated by ", " (for help texts).
 std::string result_attribute_names();
 
-// One VertexAttribute per schema entry of group Always, plus group PhongFit when `with_fit`, in
+// One VertexAttribute per schema entry of group Always, plus group ReflectanceFit when `with_fit`, in
 // table order, each with one value per record. Values are copied as they are: the PLY writer
 // refuses non-finite ones.
 std::vector<VertexAttribute> result_attributes(const std::vector<VertexRecord> &records, bool with_fit);

@@ -4,7 +4,7 @@
 // (result_attach.h) alike.
 #include <vector>
 
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 
 namespace vbrdf {
 

@@ -1,6 +1,6 @@
 #pragma once
 // The product's defaults: one table that the core's settings structs (GatherSettings,
-// PhongFitOptions, FitSettings, CoverageSettings, LightSuggestionSettings, VisibilitySettings,
+// ReflectanceFitOptions, FitSettings, CoverageSettings, LightSuggestionSettings, VisibilitySettings,
 // RelightRenderSettings) and the MeshLab filters (plugin/fit_filter.cpp, filter_parameters.cpp,
 // coverage_filter.cpp) both read, so that a core struct left at its defaults runs what a filter
 // left at its defaults runs. tests/plugin checks each filter's defaults against the core's.

@@ -27,7 +27,7 @@
 // Every stage takes d from diffuse_factor(): the gatherer stores it in Sample::d, so the CPU and GPU
 // fits, DQ/SQ, the material stage, coverage and the sample-based evaluation use the form without
 // knowing it; the relight renderer's shader and the live view evaluate the same expression (GLSL
-// copy in shaders/phong_model.glsl). The result stores it (per-vertex attribute diffuse_form, PLY
+// copy in shaders/reflectance_model.glsl). The result stores it (per-vertex attribute diffuse_form, PLY
 // header comment).
 #include <cmath>
 #include <cstdint>

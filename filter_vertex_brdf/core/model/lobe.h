@@ -13,7 +13,7 @@
 // E is the unit vector from the surface point to the camera centre, L towards the light.
 // Every stage that evaluates the lobe (the gatherer's Sample::lobe_cos, the CPU and GPU fits, the
 // material stage, the relight renderer and the sample-based evaluation) takes the cosine from
-// lobe_cosine(), so one setting (PhongFitOptions::lobe) decides the form for all of them; the
+// lobe_cosine(), so one setting (ReflectanceFitOptions::lobe) decides the form for all of them; the
 // result stores it (per-vertex attribute lobe_form, and a PLY header comment).
 //
 // Thresholds stated on R.E (T_s, the broad-lobe threshold) apply to N.H through

@@ -5,8 +5,8 @@
 //
 // d: the diffuse factor (diffuse_form.h: N.L, or N.L through a clear coat); g: the specular lobe
 // of the cosine s (lobe.h: R.E or N.H, s^alpha or GGX), seen through the photo's pixel footprint.
-// The relighting shaders evaluate the same terms (shaders/phong_model.glsl); the GPU fit's
-// (shaders/phong_fit.comp) and the GLSL constants are checked against this model by
+// The relighting shaders evaluate the same terms (shaders/reflectance_model.glsl); the GPU fit's
+// (shaders/reflectance_fit.comp) and the GLSL constants are checked against this model by
 // tests/unit/model_constants_check.py.
 //
 // Normalisation of the k_d C ambiguity: C_max = max_c C_c = 1 and k_d = max_c rho_c (k_d carries
@@ -55,10 +55,10 @@ inline void set_kd_color(const double rho[3], VertexFit &fit) {
 
 // Evaluates the model (fits, rendering, relighting and tests). Writes 3 channels.
 // d: the diffuse factor (Sample::d: N.L for Lambert, diffuse_factor() in general); lobe_cos and
-// form: the lobe's cosine (Sample::lobe_cos) and the form the fit used (PhongFitOptions::lobe).
+// form: the lobe's cosine (Sample::lobe_cos) and the form the fit used (ReflectanceFitOptions::lobe).
 // footprint: the sample's Sample::footprint (the lobe seen through the photo's pixel footprint).
 // A negative d is 0; no specular term where d <= 0 or k_s <= 0.
-inline void evaluate_phong(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out_rgb[3],
+inline void evaluate_reflectance(const VertexFit &fit, float d_in, float lobe_cos, LobeForm form, float out_rgb[3],
                            float footprint = 0) {
   const float d = std::max(d_in, 0.0f);
   const float spec =

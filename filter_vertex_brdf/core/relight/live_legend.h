@@ -11,7 +11,7 @@ struct LegendEntry {
   std::array<float, 3> rgb;  // display colour (sRGB, 0..1)
 };
 
-// fit_status codes 0..4 (phong_fit.h FitStatus), indexed by the code.
+// fit_status codes 0..4 (reflectance_fit.h FitStatus), indexed by the code.
 const std::vector<LegendEntry> &fit_status_legend();
 
 // DQ and SQ (0..2, higher is better): the colour stops at 0, 1 and 2; values between stops are

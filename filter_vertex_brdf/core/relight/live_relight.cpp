@@ -1,5 +1,5 @@
-// Live relighting (contract in live_relight.h): one shading pass with the shared Phong model
-// (shaders/phong_model.glsl) into the caller's framebuffer, or an off-screen one for tests.
+// Live relighting (contract in live_relight.h): one shading pass with the shared reflectance model
+// (shaders/reflectance_model.glsl) into the caller's framebuffer, or an off-screen one for tests.
 #include "relight/live_relight.h"
 
 #include <algorithm>
@@ -10,7 +10,7 @@
 #include "gl/gl_api.h"
 #include "gl/gl_depth.h"
 #include "relight/live_legend.h"
-#include "relight/phong_model_source.h"
+#include "relight/reflectance_model_source.h"
 
 namespace vbrdf {
 
@@ -94,7 +94,7 @@ void main() {
   vec3 e = u_eye_is_point != 0 ? normalize(u_eye - v_position) : u_eye;
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
+  reflectance_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
   c = u_display == 1 ? diffuse : u_display == 2 ? vec3(spec) : diffuse + vec3(spec);
   c *= u_exposure;
   o_color = vec4(u_encode_srgb != 0 ? srgb(c) : c, 1.0);
@@ -155,7 +155,7 @@ private:
   GlApi gl_;  // before the GL objects: they free themselves through it
   LobeForm lobe_;
   DiffuseForms diffuse_;
-  PhongMeshBuffers mesh_;
+  ModelMeshBuffers mesh_;
   double origin_[3] = {0, 0, 0};
   GlObject program_;
   GlRenderTarget target_;
@@ -173,14 +173,14 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
   program_ = GlObject::adopt(gl_, GlKind::Program,
-                             build_program(gl_, kLiveVertexShader, phong_program_source(kLiveFragmentMain).c_str(),
+                             build_program(gl_, kLiveVertexShader, reflectance_program_source(kLiveFragmentMain).c_str(),
                                            "the live relighting pass"));
   upload(mesh, fits);
   check_gl_error(gl_, "the upload of the mesh for live relighting");
 }
 
 void LiveRelight::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
-  mesh_ = upload_phong_mesh(gl_, mesh, origin_, fits, diffuse_);
+  mesh_ = upload_model_mesh(gl_, mesh, origin_, fits, diffuse_);
 }
 
 void LiveRelight::Impl::draw(const LiveView &view) {
@@ -232,7 +232,7 @@ void LiveRelight::Impl::draw(const LiveView &view) {
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_display"), int(view.display));
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_exposure"), std::isfinite(view.exposure) ? view.exposure : 1.0f);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_encode_srgb"), view.encode_srgb ? 1 : 0);
-  set_phong_model_uniforms(gl_, p, lobe_);
+  set_reflectance_model_uniforms(gl_, p, lobe_);
   std::vector<float> colors;
   for (const LegendEntry &e : fit_status_legend()) colors.insert(colors.end(), e.rgb.begin(), e.rgb.end());
   gl_.Uniform3fv(gl_.GetUniformLocation(p, "u_status_colors"), GLsizei(colors.size() / 3), colors.data());

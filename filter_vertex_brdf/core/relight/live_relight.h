@@ -1,8 +1,8 @@
 #pragma once
-// Live relighting: draws a mesh with its per-vertex Phong fits into the caller's framebuffer for a
+// Live relighting: draws a mesh with its per-vertex reflectance fits into the caller's framebuffer for a
 // view given as GL matrices and a light given in eye coordinates, as an interactive viewer has
 // them (MeshLab's render plugin "Vertex BRDF: relight" is a thin adapter over this class). The
-// model is shaders/phong_model.glsl, the same GLSL the relight renderer (relight_render.h) uses;
+// model is shaders/reflectance_model.glsl, the same GLSL the relight renderer (relight_render.h) uses;
 // their differences (no cast shadows here, orthographic views, exposure and sRGB output) are
 // stated in that file. Independent of MeshLab: GL through a get-proc-address (core 3.3 suffices).
 //
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "gl/gl_context.h"  // GetProcAddressFn
 #include "model/diffuse_form.h"
 #include "model/lobe.h"
@@ -51,7 +51,7 @@ bool eye_to_world_direction(const double modelview[16], const double eye_directi
 class LiveRelight {
 public:
   // Uploads the mesh (positions relative to its bounding-box centre, for precision) and one
-  // VertexFit per vertex (k_s = 0 vertices get the median shininess, phong_model_source.h).
+  // VertexFit per vertex (k_s = 0 vertices get the median shininess, reflectance_model_source.h).
   // Requires a current GL >= 3.3 context for the object's lifetime. Throws InputError when the
   // counts differ or an index is out of range, ProcessingError when the context cannot compile
   // the shader.

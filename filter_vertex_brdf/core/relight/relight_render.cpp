@@ -19,7 +19,7 @@
 #include "gl/gl_api.h"
 #include "gl/gl_depth.h"
 #include "gl/light_view.h"
-#include "relight/phong_model_source.h"
+#include "relight/reflectance_model_source.h"
 #include "inputs/viewpoints.h"
 #include "base/vec3.h"
 #include "visibility/visibility.h"  // resolved_shadow_map_size
@@ -36,7 +36,7 @@ const char *const kShadeVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
-layout(location = 3) in vec3 a_ks_alpha_coated;  // upload_phong_mesh's layout (location 4 unused)
+layout(location = 3) in vec3 a_ks_alpha_coated;  // upload_model_mesh's layout (location 4 unused)
 uniform mat4 u_view;
 uniform mat4 u_projection;
 out vec3 v_position;
@@ -60,8 +60,8 @@ void main() {
 // Output 0: linear RGB and the RelitPixel class in alpha; output 1: view depth.
 // Shadow test as in the visibility pass: lit when the fragment is at most u_tolerance behind the
 // farthest of the 2x2 shadow-map texels around it (forgives the map's quantisation).
-// main() of the shading pass; the model (phong_terms) is shaders/phong_model.glsl, shared with the
-// live view (phong_model_source.h).
+// main() of the shading pass; the model (reflectance_terms) is shaders/reflectance_model.glsl, shared with the
+// live view (reflectance_model_source.h).
 const char *const kShadeFragmentMain = R"(
 in vec3 v_position;
 in vec3 v_normal;
@@ -118,7 +118,7 @@ void main() {
   vec3 e = normalize(u_eye - v_position);
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
+  reflectance_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
   o_color = vec4((diffuse + vec3(spec)) * irradiance, 1.0);
 }
 )";
@@ -147,7 +147,7 @@ private:
 
   GlApi gl_;  // before the GL objects: they free themselves through it
   RelightRenderSettings settings_;
-  PhongMeshBuffers mesh_;
+  ModelMeshBuffers mesh_;
   float origin_[3] = {0, 0, 0};
   float corners_[8][3] = {};
   float radius_ = 0, tolerance_ = 0;
@@ -176,7 +176,7 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the shadow map");
   shade_program_ = GlObject::adopt(
       gl_, GlKind::Program,
-      build_program(gl_, kShadeVertexShader, phong_program_source(kShadeFragmentMain).c_str(), "the relighting pass"));
+      build_program(gl_, kShadeVertexShader, reflectance_program_source(kShadeFragmentMain).c_str(), "the relighting pass"));
   shadow_program_ = GlObject::adopt(
       gl_, GlKind::Program,
       build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map"));
@@ -186,7 +186,7 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
 
 void RelightRenderer::Impl::upload(const MeshView &mesh, const std::vector<VertexFit> &fits) {
   const double origin[3] = {origin_[0], origin_[1], origin_[2]};
-  mesh_ = upload_phong_mesh(gl_, mesh, origin, fits, settings_.diffuse);
+  mesh_ = upload_model_mesh(gl_, mesh, origin, fits, settings_.diffuse);
 }
 
 void RelightRenderer::Impl::draw() {
@@ -257,7 +257,7 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, projection.m);
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
-  set_phong_model_uniforms(gl_, p, settings_.lobe);
+  set_reflectance_model_uniforms(gl_, p, settings_.lobe);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_light_view"), 1, GL_FALSE, lv.view);
   gl_.Uniform1f(gl_.GetUniformLocation(p, "u_light_scale"), lv.scale);
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_light_perspective"), lv.perspective ? 1 : 0);

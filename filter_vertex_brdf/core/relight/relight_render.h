@@ -1,5 +1,5 @@
 #pragma once
-// Image-space relighting: renders the fitted per-vertex Phong model (phong_fit.h) with OpenGL for
+// Image-space relighting: renders the fitted per-vertex reflectance model (reflectance_fit.h) with OpenGL for
 // any camera (vcg::Shot) and light (light_source.h: directional or point), with cast shadows from
 // a shadow map (light_view.h). The render is compared with a photo pixel by pixel in
 // relight_compare.h (CIEDE2000, PSNR; the pixel rules are stated here), shown to people by
@@ -7,8 +7,8 @@
 // relight_report.h (the relight filter's table and files).
 //
 // Shading is per pixel: the vertex normal and the model parameters (rho = k_d C, k_s, alpha) are
-// interpolated over each triangle and the model is evaluated per fragment as evaluate_phong does,
-// by shaders/phong_model.glsl (shared with the live view, live_relight.h; differences stated there)
+// interpolated over each triangle and the model is evaluated per fragment as evaluate_reflectance does,
+// by shaders/reflectance_model.glsl (shared with the live view, live_relight.h; differences stated there)
 // (E from the fragment to the camera centre; the lobe's cosine R.E, R = 2(N.L)N - L, or N.H as
 // settings.lobe says; the diffuse factor N.L or coated as settings.diffuse says, diffuse_form.h). Where k_s = 0 the shininess is
 // undefined (0); such vertices take the median shininess of the fitted lobes, so that a lobe fades
@@ -32,7 +32,7 @@
 #include "inputs/camera.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "gl/gl_context.h"  // GetProcAddressFn
 
 namespace vbrdf {

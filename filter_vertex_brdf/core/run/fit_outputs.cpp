@@ -44,7 +44,7 @@ std::string color_report(const FitResult &r, const FitSettings &settings) {
   return rep.str();
 }
 
-// Linear diffuse reflectance shown and written: the fitted k_d C where the Phong fit has samples,
+// Linear diffuse reflectance shown and written: the fitted k_d C where the reflectance fit has samples,
 // else the basic estimate (mixed-pixel fallback included), else nothing.
 bool displayed_reflectance(const FitResult &r, size_t v, float rho[3]) {
   if (!r.fits.empty() && r.fits[v].status != kFitNone) {
@@ -97,7 +97,7 @@ void build_outputs(const FitInput &input, const FitSettings &settings, FitResult
     if (!r.fits.empty()) {
       const VertexFit &f = r.fits[v];
       rec.fit = f;
-      rec.lobe_form = float(uint8_t(settings.phong.lobe));
+      rec.lobe_form = float(uint8_t(settings.reflectance.lobe));
       rec.diffuse_form = float(uint8_t(r.diffuse_forms.at(v)));
       rec.diffuse_deconvolved = v < r.albedo_deconvolved.size() ? float(r.albedo_deconvolved[v]) : 0.0f;
       for (int k = 0; k < 3; ++k) rec.mesh_normal[k] = input.mesh.normals[3 * v + size_t(k)];
@@ -187,11 +187,11 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
                                            : std::string("off"))
         << "\n";
   if (settings.fit_reflectance)
-    rep << "specular lobe: " << lobe_form_name(settings.phong.lobe) << " (shininess applies to "
-        << lobe_form_label(settings.phong.lobe) << "; per-vertex lobe_form = " << int(settings.phong.lobe)
+    rep << "specular lobe: " << lobe_form_name(settings.reflectance.lobe) << " (shininess applies to "
+        << lobe_form_label(settings.reflectance.lobe) << "; per-vertex lobe_form = " << int(settings.reflectance.lobe)
         << "); diffuse term: " << r.diffuse_choice_note << " (per-vertex diffuse_form: 0 lambert, 1 coated)"
         << "; samples weighted by photo resolution: " << (settings.gather.resolution_weights ? "on" : "off")
-        << (settings.phong.lobe != LobeForm::GgxNH ? std::string()
+        << (settings.reflectance.lobe != LobeForm::GgxNH ? std::string()
             : settings.gather.footprint ? std::string("; the lobe seen through each photo's pixel footprint (shininess is "
                                                       "the surface's own; a renderer filters it per pixel)")
                                         : std::string("; the lobe at the vertex alone (no pixel footprint)"))
@@ -203,20 +203,20 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
                                                                  "through its footprint)")
         << "\n";
   if (!r.fits.empty()) {
-    rep << "Phong fit back end: " << r.fit_backend << "\n"
+    rep << "Reflectance fit back end: " << r.fit_backend << "\n"
         << "  full fits (k_d, k_s, alpha, C): " << r.fit_full << "\n"
-        << "  diffuse-only (k_s = 0; k_s/alpha stages skipped: fewer than " << settings.phong.min_specular_samples
-        << " clean highlight samples and fewer than " << settings.phong.min_lobe_samples
-        << " samples with R.E > " << settings.phong.lobe_threshold << ", or no specular term): " << r.fit_diffuse_only << "\n"
+        << "  diffuse-only (k_s = 0; k_s/alpha stages skipped: fewer than " << settings.reflectance.min_specular_samples
+        << " clean highlight samples and fewer than " << settings.reflectance.min_lobe_samples
+        << " samples with R.E > " << settings.reflectance.lobe_threshold << ", or no specular term): " << r.fit_diffuse_only << "\n"
         << "  from weak samples only (grazing N.L < T_d and/or mixed pixels; fit_status 4): " << r.fit_weak << "\n"
         << "  from neighbours (no usable sample of their own; fit_status 3): " << r.fit_neighbours << "\n"
         << "  no model (sentinels: k_d = k_s = shininess = 0; unseen, or no modelled neighbour): " << r.fit_none << "\n"
-        << "  converged before the cap of " << settings.phong.max_iterations << " iterations: " << r.fit_converged
+        << "  converged before the cap of " << settings.reflectance.max_iterations << " iterations: " << r.fit_converged
         << " of " << r.fit_full << " full fits; alpha iterations run: " << r.fit_iterations << " of at most "
-        << uint64_t(r.fit_full + r.fit_diffuse_only) * uint64_t(std::max(0, settings.phong.max_iterations)) << "\n";
+        << uint64_t(r.fit_full + r.fit_diffuse_only) * uint64_t(std::max(0, settings.reflectance.max_iterations)) << "\n";
     rep << (settings.materials ? r.materials.report : "materials: off (per-vertex lobes only)\n");
   } else {
-    rep << "Phong fit: off (basic diffuse colour only)\n";
+    rep << "Reflectance fit: off (basic diffuse colour only)\n";
   }
   // What skipping saved, estimated from the measured rates (the skipped work was never run).
   const double per_pair = r.seconds_gather > 0 && g.stored ? (r.seconds_gather - r.seconds_fit) / double(g.stored) : 0;
@@ -225,7 +225,7 @@ std::string build_report(const FitInput &input, const FitSettings &settings, con
       << fixed(per_pair * double(g.pairs - g.stored), 2) << " s";
   if (!r.fits.empty()) {
     const uint64_t fitted = r.fit_full + r.fit_diffuse_only;
-    const uint64_t cap_work = fitted * uint64_t(std::max(0, settings.phong.max_iterations));
+    const uint64_t cap_work = fitted * uint64_t(std::max(0, settings.reflectance.max_iterations));
     // Cost model: set-up of a vertex ~ 2 iterations (tests/benchmark/FIT_PERFORMANCE.md).
     const double per_iteration = r.seconds_fit / double(std::max<uint64_t>(1, r.fit_iterations + 2 * fitted));
     rep << "; " << (cap_work - std::min<uint64_t>(cap_work, r.fit_iterations))

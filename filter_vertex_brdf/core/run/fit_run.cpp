@@ -125,7 +125,7 @@ private:
 // The chunk's reflectance from its samples as they are shaded now: the back end's fit, the robust
 // basic colour for diffuse-only vertices, and the fallback fit where the strict rules left nothing.
 // diffuse[i] and fits[i] belong to chunk vertex i.
-void fit_chunk_models(SampleChunk &chunk, PhongFitter &fitter, const PhongFitOptions &options,
+void fit_chunk_models(SampleChunk &chunk, ReflectanceFitter &fitter, const ReflectanceFitOptions &options,
                       const DiffuseEstimate *diffuse, VertexFit *fits) {
   fitter.fit_chunk(chunk, options, fits);
   // Diffuse-only vertices take the robust basic colour (outlier rejection) when it is clean.
@@ -149,8 +149,8 @@ void fit_chunk_models(SampleChunk &chunk, PhongFitter &fitter, const PhongFitOpt
 // The diffuse estimate and reflectance again at the chunk's vertices with selected[i] (their
 // samples shaded anew), the others left as they are: those vertices' samples are copied into a
 // chunk of their own, fitted, and the results put back.
-void refit_selected(const SampleChunk &chunk, const std::vector<uint8_t> &selected, PhongFitter &fitter,
-                    const PhongFitOptions &options, FitResult &r) {
+void refit_selected(const SampleChunk &chunk, const std::vector<uint8_t> &selected, ReflectanceFitter &fitter,
+                    const ReflectanceFitOptions &options, FitResult &r) {
   SampleChunk part;
   std::vector<uint32_t> index;
   part.first_vertex = chunk.first_vertex;
@@ -182,7 +182,7 @@ using NormalStep = std::function<bool(SampleChunk &, const uint8_t *active, std:
 // Everything the chunk consumer produces, per vertex. `refine_normals` (may be empty): up to
 // `normal_rounds` alternations of a normal step and a refit of the vertices whose normal moved;
 // a vertex whose normal stopped moving is not solved or fitted again.
-void consume_chunk(SampleChunk &chunk, PhongFitter *fitter, const PhongFitOptions &options,
+void consume_chunk(SampleChunk &chunk, ReflectanceFitter *fitter, const ReflectanceFitOptions &options,
                    const PhotoShadowSettings &photo_shadows, const NormalStep &refine_normals, int normal_rounds,
                    FitResult &r, double &fit_seconds) {
   r.rim_samples_demoted += prefer_clean_samples(chunk);
@@ -217,7 +217,7 @@ void run_material_stage(const FitInput &input, const FitSettings &settings, cons
     valid[v] = e.valid && !e.from_mixed_pixels;
     for (int c = 0; c < 3; ++c) rgb[3 * v + size_t(c)] = e.rgb[c];
   }
-  r.materials = fit_materials(input.mesh, store, settings.phong, settings.material_options, rgb.data(), valid.data(), r.fits);
+  r.materials = fit_materials(input.mesh, store, settings.reflectance, settings.material_options, rgb.data(), valid.data(), r.fits);
   std::istringstream lines(r.materials.report);
   for (std::string line; std::getline(lines, line);) log(line);
 }
@@ -294,11 +294,11 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
     result.diffuse_forms = DiffuseForms::everywhere(
         settings.diffuse_choice == DiffuseTermChoice::Coated ? DiffuseForm::Coated : DiffuseForm::Lambert);
     result.diffuse_choice_note = describe_diffuse_forms(result.diffuse_forms) +
-                                 (settings.fit_reflectance ? " (as set)" : " (no Phong fit: the thesis's form)");
+                                 (settings.fit_reflectance ? " (as set)" : " (no reflectance fit: the thesis's form)");
   } else {
     const size_t loads_before = photos.loads();
     const DiffuseChoice choice =
-        choose_diffuse_forms(input.mesh, input.rasters, lights, masks, settings.gather, settings.phong, photos, prepare);
+        choose_diffuse_forms(input.mesh, input.rasters, lights, masks, settings.gather, settings.reflectance, photos, prepare);
     const size_t decoded_again = photos.loads() - loads_before;
     result.diffuse_forms = choice.forms;
     result.diffuse_choice_note = choice.note + (choice.piloted ? ", " + fixed(choice.seconds) + " s" : "") +
@@ -326,7 +326,7 @@ NormalStep shading_normal_refiner(const FitInput &input, const std::vector<Light
     const auto t = Clock::now();
     moved.assign(chunk.vertex_count, 0);
     const ShadingNormalCounts counts = refine_shading_normals(
-        chunk, input.mesh, *adjacency, input.rasters, lights, settings.gather.diffuse, settings.phong.lobe,
+        chunk, input.mesh, *adjacency, input.rasters, lights, settings.gather.diffuse, settings.reflectance.lobe,
         &result.fits[chunk.first_vertex], settings.shading_normals, active, result.shading_normals.data(),
         result.normal_moved.data(), moved.data());
     if (!active) {  // the first round decides which vertices the photos determine
@@ -394,7 +394,7 @@ struct FitRun {
   FitInput input;        // its rasters take the corrected cameras (registration); the caller's never change
   FitSettings settings;  // as every stage reads them (settings_for_run)
   VisibilityBackend &visibility;
-  PhongFitter *fitter;   // null when settings.fit_reflectance is false
+  ReflectanceFitter *fitter;   // null when settings.fit_reflectance is false
   const ProgressFn &progress;
   const LogFn &log;
   LightPlacement placement;
@@ -404,14 +404,14 @@ struct FitRun {
 
 // The settings as every stage reads them: one T_s and one lobe form for the samples and the fit,
 // and the mesh's normal gradients computed once for the pilot's and the fit's gathers.
-FitSettings settings_for_run(const FitSettings &given, const MeshView &mesh, const PhongFitter *fitter) {
+FitSettings settings_for_run(const FitSettings &given, const MeshView &mesh, const ReflectanceFitter *fitter) {
   FitSettings settings = given;
-  settings.phong.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
-  settings.gather.lobe = settings.phong.lobe;  // one lobe form for the samples and the fit (lobe.h)
+  settings.reflectance.specular_threshold = settings.gather.specular_threshold;  // one T_s for all stages
+  settings.gather.lobe = settings.reflectance.lobe;  // one lobe form for the samples and the fit (lobe.h)
   if (settings.fit_reflectance && settings.gather.footprint && settings.gather.lobe == LobeForm::GgxNH)
     settings.gather.normal_gradients =  // once for the pilot's and the fit's gathers (footprint.h)
         std::make_shared<const std::vector<float>>(normal_gradients(mesh));
-  if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Phong fit back end");
+  if (settings.fit_reflectance && !fitter) throw ProcessingError("internal: no Reflectance fit back end");
   return settings;
 }
 
@@ -557,16 +557,16 @@ void gather_and_fit(FitRun &run, PhotoCache &photos, const VisibilityMasks &mask
   const NormalStep refine_normals = settings.fit_reflectance && settings.shading_normals.enabled
                                         ? shading_normal_refiner(input, run.lights, settings, result)
                                         : NormalStep();
-  PhongFitter *fitter = settings.fit_reflectance ? run.fitter : nullptr;
+  ReflectanceFitter *fitter = settings.fit_reflectance ? run.fitter : nullptr;
   result.gather = gather_samples(
       mesh, input.rasters, run.lights, masks, settings.gather, photos,
       [&](SampleChunk &chunk) {
         if (correct) correct_samples(colors, chunk);
         agreement.add(chunk, mesh, run.lights);
         apply_light_falloff(chunk, mesh, run.lights);  // after the correction, which need not be linear
-        consume_chunk(chunk, fitter, settings.phong, settings.photo_shadows, refine_normals,
+        consume_chunk(chunk, fitter, settings.reflectance, settings.photo_shadows, refine_normals,
                       settings.shading_normals.rounds, result, result.seconds_fit);
-        if (with_materials) material_samples.add_chunk(chunk, &result.fits[chunk.first_vertex], settings.phong);
+        if (with_materials) material_samples.add_chunk(chunk, &result.fits[chunk.first_vertex], settings.reflectance);
       },
       gather_progress);
   result.seconds_gather = seconds_since(started);
@@ -643,7 +643,7 @@ void write_outputs(FitRun &run, const FitInput &given) {
 } // namespace
 
 FitResult run_fit(const FitInput &given, const FitSettings &settings, VisibilityBackend &visibility,
-                  PhongFitter *fitter, const ProgressFn &progress, const LogFn &log) {
+                  ReflectanceFitter *fitter, const ProgressFn &progress, const LogFn &log) {
   validate_input(given);
   FitRun run{given, settings_for_run(settings, given.mesh, fitter), visibility, fitter, progress, log, {}, {}, {}};
   FitResult &result = run.result;

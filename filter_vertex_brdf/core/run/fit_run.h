@@ -1,7 +1,7 @@
 #pragma once
 // The whole filter without MeshLab: project -> lights -> colour calibration (per viewpoint, from a
 // ColorChecker in the photos) -> visibility -> samples (colour-corrected) -> diffuse colour and
-// Phong fit (per vertex chunk) -> outputs. The plugin and the command-line tool both call this; they only differ in how they
+// reflectance fit (per vertex chunk) -> outputs. The plugin and the command-line tool both call this; they only differ in how they
 // obtain the mesh, the rasters and the GL context.
 #include <array>
 #include <functional>
@@ -13,9 +13,9 @@
 #include "calibration/color_plan.h"  // ColorCorrectionChoice: Off, Auto (where a chart is found), Required
 #include "samples/diffuse_color.h"
 #include "fit/albedo_deconvolution.h"
-#include "fit/fit_backends.h"  // VisibilityChoice, FitBackendChoice, PhongFitter, their factories
+#include "fit/fit_backends.h"  // VisibilityChoice, FitBackendChoice, ReflectanceFitter, their factories
 #include "fit/neighbour_fill.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "fit/materials.h"
 #include "fit/photo_shadows.h"
 #include "fit/shading_normals.h"
@@ -32,13 +32,13 @@
 namespace vbrdf {
 
 // Every default is the product's (model/defaults.h: the lobe, T_s, T_d, the diffuse form); the
-// pipeline copies phong.lobe into gather.lobe.
+// run copies reflectance.lobe into gather.lobe.
 struct FitSettings {
   GatherSettings gather;
   VisibilitySettings visibility;
   VisibilityChoice visibility_choice = VisibilityChoice::Auto;
   bool fit_reflectance = true;         // false: basic diffuse colour only (no k_d/k_s/alpha)
-  PhongFitOptions phong;               // its specular_threshold is taken from gather
+  ReflectanceFitOptions reflectance;               // its specular_threshold is taken from gather
   DiffuseTermChoice diffuse_choice = kFitDiffuseChoice;
   FitBackendChoice fit_backend = FitBackendChoice::Auto;
   QualityOutput quality = QualityOutput::DQ;  // what goes into vertex quality
@@ -72,7 +72,7 @@ struct FitSettings {
   // albedo edge (fit/albedo_deconvolution.h): each vertex's own albedo instead of the footprint's
   // blend of its neighbours' (sharp material boundaries and painted lines). The result's
   // diffuse_deconvolved = 1 marks those vertices; the relighting evaluation predicts photos there
-  // through the same footprints. Phong fit only. On by default.
+  // through the same footprints. reflectance fit only. On by default.
   bool deconvolve_albedo = true;
   DeconvolutionSettings deconvolution;
   // Each viewpoint's camera measured against its photos and corrected where it is off by more than
@@ -82,7 +82,7 @@ struct FitSettings {
   // Each vertex's shading normal refined from its samples, jointly with its reflectance
   // (fit/shading_normals.h): fit with the mesh's normals, refine, shade the samples again, fit
   // again. Visibility and shadows keep the mesh. The PLY's nx ny nz are the refined normals
-  // (mesh_nx ny nz keep the mesh's). Phong fit only; vertices the samples do not determine keep
+  // (mesh_nx ny nz keep the mesh's). reflectance fit only; vertices the samples do not determine keep
   // the mesh normal.
   ShadingNormalSettings shading_normals;
 };
@@ -110,7 +110,7 @@ void validate_input(const FitInput &input);
 struct FitResult {
   RegistrationResult registration;        // per viewpoint: measured, corrected or why not (empty when off)
   // The shading normals (3 per vertex, unit): the mesh's where the photos do not determine them.
-  // Empty when refinement is off or did not run (no Phong fit): the mesh's normals throughout.
+  // Empty when refinement is off or did not run (no reflectance fit): the mesh's normals throughout.
   std::vector<float> shading_normals;
   std::vector<float> normal_moved;        // per vertex: degrees from the mesh normal, -1 not determined
   ShadingNormalCounts shading_normal_counts;
@@ -164,7 +164,7 @@ struct FitResult {
 // (base/output_file.h), so concurrent runs leave one run's complete pair. `fitter` may be null when settings.fit_reflectance is false.
 // Throws InputError / ProcessingError.
 FitResult run_fit(const FitInput &input, const FitSettings &settings, VisibilityBackend &visibility,
-                  PhongFitter *fitter, const ProgressFn &progress, const LogFn &log);
+                  ReflectanceFitter *fitter, const ProgressFn &progress, const LogFn &log);
 
 // Default output path for a project: <folder>/<name>_brdf.ply ("vertex_brdf.ply" in the
 // current folder when no project path is known).

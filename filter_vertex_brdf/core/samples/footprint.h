@@ -12,7 +12,7 @@
 // linearly over each triangle, as renderers shade) times the surface step of one pixel (the
 // pixel's ray moved by one pixel, met on the vertex's tangent plane). kPhotoFootprintVariance:
 // the variance in pixels^2, per axis, of a box pixel (1/12) resampled bilinearly (a tent, 1/6).
-// The GL renderer takes the same quantity from its own derivatives (shaders/phong_model.glsl,
+// The GL renderer takes the same quantity from its own derivatives (shaders/reflectance_model.glsl,
 // one box pixel: 1/12).
 #include <cstddef>
 #include <vector>

@@ -98,7 +98,7 @@ struct GatherSettings {
   // choice). false: plain bilinear over all 4 texels, mixed or not (the RTI evaluation protocol:
   // held-out photos are compared as sampled, contamination included).
   bool own_surface_texels = true;
-  // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's PhongFitOptions::lobe
+  // The lobe's cosine stored in Sample::lobe_cos (lobe.h). The fit's ReflectanceFitOptions::lobe
   // (run/fit_run.cpp keeps them equal). kHighlight stays R.E > T_s whichever the form.
   LobeForm lobe = kDefaultLobe;
   // The diffuse term's form stored in Sample::d (diffuse_form.h), per vertex where it varies

@@ -264,7 +264,7 @@ bool scores(const Evaluation &ev, const Sample &s, size_t v) {
 // and through the rendered image's footprint where the pixel straddles a depth jump.
 void predict_sample(const Evaluation &ev, const Sample &s, size_t v, float predicted[3]) {
   const VertexFit &fit = ev.fits[v];
-  evaluate_phong(ev.seen_albedo_of.as_seen(fit, s.raster, v), s.d, s.lobe_cos, ev.options.gather.lobe, predicted,
+  evaluate_reflectance(ev.seen_albedo_of.as_seen(fit, s.raster, v), s.d, s.lobe_cos, ev.options.gather.lobe, predicted,
                  s.footprint);
   const float irradiance = light_irradiance_at(ev.lights[s.raster], ev.mesh.positions + 3 * v);
   for (int c = 0; c < 3; ++c) predicted[c] *= irradiance;

@@ -1,5 +1,5 @@
 #pragma once
-// Relighting evaluation: predicts, with the fitted per-vertex Phong model, what photos taken
+// Relighting evaluation: predicts, with the fitted per-vertex reflectance model, what photos taken
 // under other lights (held out from the fit) show at every vertex, and scores the prediction in
 // CIELAB (CIEDE2000) and PSNR over the whole visible surface, the protocol by which RTI tools are
 // judged; optionally beside per-pixel PTM and RBF baselines fitted on the training photos
@@ -11,7 +11,7 @@
 
 #include "inputs/camera.h"
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "relight/relight_render.h"
 #include "samples/samples.h"
 
@@ -41,7 +41,7 @@ struct RelightOptions {
   // camera records it (relight_render.h render_as_photographed). The product then predicts a
   // sample as the photo is sampled: bilinearly over the vertex's 2x2 pixel footprint, where the
   // pixels on the vertex's own surface (the camera pass's footprint mask) take the vertex's model
-  // (evaluate_phong) and, at silhouettes and contacts, the others (background, another surface)
+  // (evaluate_reflectance) and, at silhouettes and contacts, the others (background, another surface)
   // take that image. Inside a surface this is exactly the vertex's model.
   const std::vector<cv::Mat> *rendered = nullptr;
   // Optional (null = none): one flag per vertex, non-zero where the fit's k_d C is the vertex's own
@@ -77,7 +77,7 @@ struct ScoredSample {
 struct RelightStats {
   // Whole surface: every held-out sample that is seen, lit (no kShadowed flag, N.L > 0) and
   // unsaturated, at every scored vertex; mixed pixels included. Vertices without a model
-  // (kFitNone) are predicted as evaluate_phong gives them (black): what a user relighting the PLY sees.
+  // (kFitNone) are predicted as evaluate_reflectance gives them (black): what a user relighting the PLY sees.
   size_t samples = 0;       // compared vertex x photo pairs
   double mean_de2000 = 0;
   double median_de2000 = 0;
@@ -113,7 +113,7 @@ struct RelightStats {
 };
 
 // `fits` has one entry per vertex; `rasters` / `lights` are the held-out photos. The product
-// predicts evaluate_phong times the light's irradiance at the vertex (light_irradiance_at: point
+// predicts evaluate_reflectance times the light's irradiance at the vertex (light_irradiance_at: point
 // lights fall off with distance; directional ones give their intensity, 1). Any
 // status other than kFitNone counts as modelled. Visibility comes from `visibility` (built for
 // `mesh`); held-out and training photos are gathered in one pass. Throws InputError on size

@@ -1,23 +1,23 @@
-// CPU reference Phong fit: parameter recovery, diffuse-hole remedy, degenerate input.
+// CPU reference reflectance fit: parameter recovery, diffuse-hole remedy, degenerate input.
 #include <cmath>
 #include <gtest/gtest.h>
 #include <random>
 
-#include "fit/phong_fit.h"
-#include "phong_test_util.h"
+#include "fit/reflectance_fit.h"
+#include "reflectance_test_util.h"
 #include "thesis_settings.h"
 
 using namespace vbrdf;
-using test::TruePhong;
+using test::TrueReflectance;
 
 namespace {
 float rel_err(float a, float b) { return std::fabs(a - b) / std::max(std::fabs(b), 1e-6f); }
 float rho_of(const VertexFit &f, int c) { return f.kd * f.color[c]; }
 } // namespace
 
-TEST(PhongFit, RecoversExactParametersWithoutNoise) {
+TEST(ReflectanceFit, RecoversExactParametersWithoutNoise) {
   std::mt19937 rng(1);
-  const TruePhong t{{0.5f, 0.3f, 0.1f}, 0.4f, 40.0f};
+  const TrueReflectance t{{0.5f, 0.3f, 0.1f}, 0.4f, 40.0f};
   const auto s = test::synth_samples(t, 40, 0.0f, rng);
   VertexFit f;
   fit_vertex_cpu(s.data(), s.size(), vbrdf::test::thesis_fit_options(), f);
@@ -30,13 +30,13 @@ TEST(PhongFit, RecoversExactParametersWithoutNoise) {
   EXPECT_GT(f.dq, 1.0f);
 }
 
-TEST(PhongFit, RecoveryOverWideRanges) {
+TEST(ReflectanceFit, RecoveryOverWideRanges) {
   // k_d 0.02-1, k_s 0-1, alpha 1-500, 3-500 samples, noise 0-5 %: tolerances scale with noise.
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> u(0, 1);
   int checked = 0, failures = 0;
   for (int trial = 0; trial < 400; ++trial) {
-    TruePhong t;
+    TrueReflectance t;
     const float kd = 0.02f + 0.98f * u(rng);
     for (int c = 0; c < 3; ++c) t.rho[c] = kd * (c == trial % 3 ? 1.0f : 0.2f + 0.8f * u(rng));
     t.ks = (trial % 5 == 0) ? 0.0f : u(rng);
@@ -68,16 +68,16 @@ TEST(PhongFit, RecoveryOverWideRanges) {
   EXPECT_LE(failures, checked / 50);  // at most 2 %
 }
 
-TEST(PhongFit, DiffuseHoleRemedy) {
+TEST(ReflectanceFit, DiffuseHoleRemedy) {
   // Thesis 5.1.2: a vertex with two highlight samples (one of them a glint far above the
   // Phong lobe) ends with k_d ~ 0 and a huge k_s when the specular evidence is unchecked.
-  const TruePhong t{{0.4f, 0.4f, 0.4f}, 0.3f, 30.0f};
+  const TrueReflectance t{{0.4f, 0.4f, 0.4f}, 0.3f, 30.0f};
   std::vector<Sample> s;
   const float ds[] = {0.95f, 0.6f, 0.55f};
   for (float d : ds) s.push_back(Sample{{0.4f * d, 0.4f * d, 0.4f * d}, d, 0.2f, 0, 0});
   s.push_back(Sample{{2.5f, 2.5f, 2.5f}, 0.97f, 0.995f, 0, kHighlight});
   s.push_back(Sample{{1.9f, 1.9f, 1.9f}, 0.96f, 0.93f, 0, kHighlight});
-  PhongFitOptions unchecked = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions unchecked = vbrdf::test::thesis_fit_options();
   unchecked.specular_weight_cap = 1e9f;
   unchecked.diffuse_prior = 0;
   unchecked.min_specular_samples = 1;
@@ -94,7 +94,7 @@ TEST(PhongFit, DiffuseHoleRemedy) {
   EXPECT_NEAR(good.kd, 0.4f, 0.06f);  // and the remedies remove it
 }
 
-TEST(PhongFit, TooFewHighlightsGiveDiffuseOnly) {
+TEST(ReflectanceFit, TooFewHighlightsGiveDiffuseOnly) {
   std::vector<Sample> s = {{{0.3f, 0.2f, 0.1f}, 0.6f, 0.1f, 0, 0}, {{0.45f, 0.3f, 0.15f}, 0.9f, 0.3f, 0, 0},
                            {{0.9f, 0.9f, 0.9f}, 0.8f, 0.95f, 0, kHighlight}};
   VertexFit f;
@@ -145,7 +145,7 @@ std::vector<Sample> half_angle_vertex(const float e[3], float alpha, LobeForm fo
 // the same lights): the own form recovers the parameters and fits exactly, the rival cannot follow
 // the lobe and leaves a residual. Returns the own form's fit.
 VertexFit expect_form_recovered_and_rival_worse(LobeForm truth, LobeForm rival, const float e[3], unsigned seed) {
-  PhongFitOptions own, other;
+  ReflectanceFitOptions own, other;
   own.lobe = truth;
   other.lobe = rival;
   std::mt19937 rng(seed);
@@ -169,18 +169,18 @@ VertexFit expect_form_recovered_and_rival_worse(LobeForm truth, LobeForm rival, 
 // A GGX highlight (the microfacet lobe, long tails): the GGX form recovers its roughness (as the
 // Phong-equivalent exponent) and k_s and fits it exactly; Blinn-Phong, whose (N.H)^alpha has no such
 // tails, cannot, and leaves a residual.
-TEST(PhongFit, GgxLobeIsRecoveredAndFitsBetterThanBlinnPhong) {
+TEST(ReflectanceFit, GgxLobeIsRecoveredAndFitsBetterThanBlinnPhong) {
   const float e[3] = {0.5f, 0, 0.8660254f};  // 30 degrees off the normal
   const VertexFit f = expect_form_recovered_and_rival_worse(LobeForm::GgxNH, LobeForm::BlinnNH, e, 9);
   float out[3];
-  evaluate_phong(f, 0.5f, 1.0f, LobeForm::GgxNH, out);  // at the lobe's peak: k_d C d + k_s
+  evaluate_reflectance(f, 0.5f, 1.0f, LobeForm::GgxNH, out);  // at the lobe's peak: k_d C d + k_s
   EXPECT_NEAR(out[0], f.kd * f.color[0] * 0.5f + f.ks, 1e-5);
 }
 
 // A Blinn-Phong highlight seen away from the camera axis: the N.H form recovers its exponent and
 // fits it exactly; the thesis's R.E form cannot follow it (the R-E and N-H angles are tied only in
 // the plane of incidence) and leaves a residual.
-TEST(PhongFit, HalfAngleLobeIsRecoveredAndFitsBetterThanMirrorLobe) {
+TEST(ReflectanceFit, HalfAngleLobeIsRecoveredAndFitsBetterThanMirrorLobe) {
   const float e[3] = {0.7071068f, 0, 0.7071068f};  // 45 degrees off the normal
   const VertexFit f_nh = expect_form_recovered_and_rival_worse(LobeForm::BlinnNH, LobeForm::PhongRE, e, 5);
   EXPECT_GT(f_nh.sq, 0);  // SQ's sampling term on the R.E scale (2 c^2 - 1)

@@ -1,7 +1,7 @@
-// GPU back end of the Phong fit (contract in phong_fit_gpu.h / phong_fit.h). The chunk's samples
+// GPU back end of the reflectance fit (contract in reflectance_fit_gpu.h / reflectance_fit.h). The chunk's samples
 // go to the GPU as they are (Sample is already a packed std430 struct) in dispatch batches by
 // vertex range; two buffer sets alternate so that a batch is uploaded while the previous one runs.
-#include "fit/phong_fit_gpu.h"
+#include "fit/reflectance_fit_gpu.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -24,15 +24,15 @@ namespace vbrdf {
 // fields pack into one uint as raster | flags << 16 | resolution << 26 (bit-fields: the word's layout
 // is checked by tests/unit/test_samples.cpp SampleWordMatchesTheShader) and iterations | status << 16
 // | converged << 24).
-static_assert(sizeof(Sample) == 28 && offsetof(Sample, raster) == 20 && offsetof(Sample, footprint) == 24, "Sample layout must match shaders/phong_fit.comp");
+static_assert(sizeof(Sample) == 28 && offsetof(Sample, raster) == 20 && offsetof(Sample, footprint) == 24, "Sample layout must match shaders/reflectance_fit.comp");
 static_assert(sizeof(VertexFit) == 40 && offsetof(VertexFit, kd) == 12 && offsetof(VertexFit, rmse) == 32 &&
                   offsetof(VertexFit, iterations) == 36 && offsetof(VertexFit, status) == 38 &&
                   offsetof(VertexFit, converged) == 39,
-              "VertexFit layout must match shaders/phong_fit.comp");
+              "VertexFit layout must match shaders/reflectance_fit.comp");
 
 namespace {
 
-const char *const kLabel = "the GPU Phong fit";
+const char *const kLabel = "the GPU reflectance fit";
 const GLuint kLocalSize = 64;                  // local_size_x of the shader
 const GLuint kSamplesBinding = 0, kOffsetsBinding = 1, kFitsBinding = 2, kOrderBinding = 3;
 const size_t kDefaultBatchBytes = size_t(64) << 20;
@@ -41,7 +41,7 @@ const uint32_t kMaxBatchVertices = 65535u * kLocalSize;  // guaranteed work-grou
 const GLsizeiptr kMinBufferBytes = 256;        // never bind an empty range
 
 // Shader source: embedded into the library at build time (embed_shaders.cmake).
-std::string phong_fit_source() { return shaders::phong_fit_comp; }
+std::string reflectance_fit_source() { return shaders::reflectance_fit_comp; }
 
 struct Uniforms {
   GLint vertex_count = -1, sample_base = -1, alpha_init = -1, alpha_min = -1, alpha_max = -1;
@@ -60,14 +60,14 @@ struct Slot {
 // Throws unless the chunk's CSR arrays are consistent: the shader trusts them for its loop bounds.
 void validate_chunk(const SampleChunk &chunk) {
   if (chunk.offsets.size() != size_t(chunk.vertex_count) + 1)
-    throw ProcessingError("GPU Phong fit: the sample chunk has " + std::to_string(chunk.offsets.size()) +
+    throw ProcessingError("GPU reflectance fit: the sample chunk has " + std::to_string(chunk.offsets.size()) +
                           " offsets for " + std::to_string(chunk.vertex_count) + " vertices (expected one more).");
   for (size_t i = 0; i < chunk.vertex_count; ++i)
     if (chunk.offsets[i] > chunk.offsets[i + 1])
-      throw ProcessingError("GPU Phong fit: the sample offsets decrease at vertex " +
+      throw ProcessingError("GPU reflectance fit: the sample offsets decrease at vertex " +
                             std::to_string(chunk.first_vertex + i) + ".");
   if (chunk.offsets.back() > chunk.samples.size())
-    throw ProcessingError("GPU Phong fit: the sample offsets point past the chunk's " +
+    throw ProcessingError("GPU reflectance fit: the sample offsets point past the chunk's " +
                           std::to_string(chunk.samples.size()) + " samples.");
 }
 
@@ -85,7 +85,7 @@ void reserve_buffer(const GlApi &gl, GLuint buffer, GLsizeiptr &capacity, GLsize
 // Vertices [first, end) as batch-relative indices, those that will iterate (enough highlight
 // samples to free k_s) first: an invocation runs ~5x longer when it iterates, and a SIMD group /
 // warp runs as long as its slowest lane. Only a heuristic: the usability test is approximate.
-void work_order(const SampleChunk &chunk, uint32_t first, uint32_t end, const PhongFitOptions &o,
+void work_order(const SampleChunk &chunk, uint32_t first, uint32_t end, const ReflectanceFitOptions &o,
                 std::vector<uint32_t> &order) {
   order.resize(end - first);
   auto iterating = [&](uint32_t i) {
@@ -110,7 +110,7 @@ void upload(const GlApi &gl, GLuint buffer, const void *data, GLsizeiptr bytes) 
 
 } // namespace
 
-struct PhongFitGpu::Impl {
+struct ReflectanceFitGpu::Impl {
   GlApi gl;  // before the GL objects: they free themselves through it
   GlObject program;
   Uniforms uniforms;
@@ -122,17 +122,17 @@ struct PhongFitGpu::Impl {
   std::vector<uint32_t> order;  // work order of the batch being uploaded
 
   explicit Impl(const GetProcAddressFn &get_proc);
-  void set_options(const PhongFitOptions &o) const;
+  void set_options(const ReflectanceFitOptions &o) const;
   uint32_t batch_end(const SampleChunk &chunk, uint32_t first) const;
-  void dispatch(Slot &slot, const SampleChunk &chunk, const PhongFitOptions &o, uint32_t first, uint32_t end);
+  void dispatch(Slot &slot, const SampleChunk &chunk, const ReflectanceFitOptions &o, uint32_t first, uint32_t end);
   void read_back(Slot &slot, VertexFit *out);
 };
 
-PhongFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_proc)) {
+ReflectanceFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_proc)) {
   require_compute(gl, kLabel);
   GlStateGuard guard(gl);
   clear_gl_errors(gl);  // errors left by the host are not ours
-  const std::string source = phong_fit_source();
+  const std::string source = reflectance_fit_source();
   program = GlObject::adopt(gl, GlKind::Program, build_compute_program(gl, source.c_str(), kLabel));
   Uniforms &u = uniforms;
   const struct {
@@ -150,13 +150,13 @@ PhongFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_p
   for (const auto &n : names) {
     *n.location = gl.GetUniformLocation(program, n.name);
     if (*n.location < 0)
-      throw ProcessingError(std::string("GPU Phong fit: the shader has no active uniform ") + n.name + ".");
+      throw ProcessingError(std::string("GPU reflectance fit: the shader has no active uniform ") + n.name + ".");
   }
   GLint max_block = 0;
   gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
   max_block_bytes = GLsizeiptr(max_block);
   if (max_block_bytes < GLsizeiptr(sizeof(Sample)))
-    throw ProcessingError("GPU Phong fit: GL_MAX_SHADER_STORAGE_BLOCK_SIZE is " + std::to_string(max_block) +
+    throw ProcessingError("GPU reflectance fit: GL_MAX_SHADER_STORAGE_BLOCK_SIZE is " + std::to_string(max_block) +
                           " bytes on " + gl.version_string() + ".");
   batch_bytes = std::min(batch_bytes, size_t(max_block_bytes));
   for (Slot &s : slots) {
@@ -168,7 +168,7 @@ PhongFitGpu::Impl::Impl(const GetProcAddressFn &get_proc) : gl(load_gl_api(get_p
   check_gl_error(gl, "the set-up of " + std::string(kLabel));
 }
 
-void PhongFitGpu::Impl::set_options(const PhongFitOptions &o) const {
+void ReflectanceFitGpu::Impl::set_options(const ReflectanceFitOptions &o) const {
   const Uniforms &u = uniforms;
   gl.Uniform1f(u.alpha_init, o.alpha_init);
   gl.Uniform1f(u.alpha_min, o.alpha_min);
@@ -189,7 +189,7 @@ void PhongFitGpu::Impl::set_options(const PhongFitOptions &o) const {
 
 // End of the batch starting at vertex `first`: at most batch_vertices vertices and batch_bytes of
 // samples, but always at least one vertex (which must fit the GL storage-block limit).
-uint32_t PhongFitGpu::Impl::batch_end(const SampleChunk &chunk, uint32_t first) const {
+uint32_t ReflectanceFitGpu::Impl::batch_end(const SampleChunk &chunk, uint32_t first) const {
   const uint32_t last = uint32_t(std::min<uint64_t>(uint64_t(first) + batch_vertices, chunk.vertex_count));
   const uint64_t limit = uint64_t(chunk.offsets[first]) + batch_bytes / sizeof(Sample);
   const auto begin = chunk.offsets.begin() + first + 1, end = chunk.offsets.begin() + last + 1;
@@ -199,14 +199,14 @@ uint32_t PhongFitGpu::Impl::batch_end(const SampleChunk &chunk, uint32_t first) 
   if (stop > first) return stop;
   const uint64_t bytes = uint64_t(chunk.offsets[first + 1] - chunk.offsets[first]) * sizeof(Sample);
   if (bytes > uint64_t(max_block_bytes))
-    throw ProcessingError("GPU Phong fit: vertex " + std::to_string(chunk.first_vertex + first) + " has " +
+    throw ProcessingError("GPU reflectance fit: vertex " + std::to_string(chunk.first_vertex + first) + " has " +
                           std::to_string(bytes) + " bytes of samples, more than this GPU's shader storage block (" +
                           std::to_string(max_block_bytes) + " bytes): use the CPU fit.");
   return first + 1;
 }
 
 // Uploads vertices [first, end) into `slot` and dispatches them. The caller holds the guards.
-void PhongFitGpu::Impl::dispatch(Slot &slot, const SampleChunk &chunk, const PhongFitOptions &o, uint32_t first,
+void ReflectanceFitGpu::Impl::dispatch(Slot &slot, const SampleChunk &chunk, const ReflectanceFitOptions &o, uint32_t first,
                                  uint32_t end) {
   const uint32_t count = end - first;
   const uint32_t base = chunk.offsets[first];
@@ -240,7 +240,7 @@ void PhongFitGpu::Impl::dispatch(Slot &slot, const SampleChunk &chunk, const Pho
 }
 
 // Waits for the slot's dispatch and copies its fits into out[first .. first + count).
-void PhongFitGpu::Impl::read_back(Slot &slot, VertexFit *out) {
+void ReflectanceFitGpu::Impl::read_back(Slot &slot, VertexFit *out) {
   if (!slot.pending) return;
   slot.pending = false;
   gl.MemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -250,11 +250,11 @@ void PhongFitGpu::Impl::read_back(Slot &slot, VertexFit *out) {
   check_gl_error(gl, "the read-back of " + std::string(kLabel));
 }
 
-PhongFitGpu::PhongFitGpu(const GetProcAddressFn &get_proc) : impl_(new Impl(get_proc)) {}
+ReflectanceFitGpu::ReflectanceFitGpu(const GetProcAddressFn &get_proc) : impl_(new Impl(get_proc)) {}
 
-PhongFitGpu::~PhongFitGpu() = default;
+ReflectanceFitGpu::~ReflectanceFitGpu() = default;
 
-void PhongFitGpu::fit_chunk(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out) {
+void ReflectanceFitGpu::fit_chunk(const SampleChunk &chunk, const ReflectanceFitOptions &options, VertexFit *out) {
   Impl &m = *impl_;
   m.dispatches = 0;
   if (chunk.vertex_count == 0) return;
@@ -282,20 +282,20 @@ void PhongFitGpu::fit_chunk(const SampleChunk &chunk, const PhongFitOptions &opt
   }
 }
 
-void PhongFitGpu::set_batch_vertices(uint32_t vertices) {
+void ReflectanceFitGpu::set_batch_vertices(uint32_t vertices) {
   impl_->batch_vertices = std::min(std::max(vertices, kLocalSize), kMaxBatchVertices);
 }
 
-uint32_t PhongFitGpu::batch_vertices() const { return impl_->batch_vertices; }
+uint32_t ReflectanceFitGpu::batch_vertices() const { return impl_->batch_vertices; }
 
-void PhongFitGpu::set_batch_bytes(size_t bytes) {
+void ReflectanceFitGpu::set_batch_bytes(size_t bytes) {
   impl_->batch_bytes = std::max(std::min(bytes, size_t(impl_->max_block_bytes)), sizeof(Sample));
 }
 
-size_t PhongFitGpu::batch_bytes() const { return impl_->batch_bytes; }
+size_t ReflectanceFitGpu::batch_bytes() const { return impl_->batch_bytes; }
 
-std::string PhongFitGpu::device() const { return impl_->gl.version_string(); }
+std::string ReflectanceFitGpu::device() const { return impl_->gl.version_string(); }
 
-size_t PhongFitGpu::last_dispatch_count() const { return impl_->dispatches; }
+size_t ReflectanceFitGpu::last_dispatch_count() const { return impl_->dispatches; }
 
 } // namespace vbrdf

@@ -1,6 +1,6 @@
 #version 430
-// Per-vertex Phong fit, one invocation per vertex, float32. Contract: core/fit/phong_fit.h; this is a
-// transcription of the double-precision reference core/fit/phong_fit_cpu.cpp (keep them in step).
+// Per-vertex reflectance fit, one invocation per vertex, float32. Contract: core/fit/reflectance_fit.h; this is a
+// transcription of the double-precision reference core/fit/reflectance_fit_cpu.cpp (keep them in step).
 // There are no per-vertex arrays in GLSL, so every stage loops over the vertex's sample range again
 // ("passes"); a dropped highlight sample is skipped by every loop.
 //
@@ -13,7 +13,7 @@
 //   as a sum of squares when it cancels, so that the singularity test means what it does in double;
 // - the objective is summed with Kahan compensation: the 1e-5 convergence test is near the
 //   rounding error of a plain float sum over a few hundred samples.
-// Both back ends keep the contract alike (tests/unit/test_phong_gpu.cpp): a sample with N.L = +Inf
+// Both back ends keep the contract alike (tests/unit/test_reflectance_fit_gpu.cpp): a sample with N.L = +Inf
 // is not usable; the alpha_from_highlights fallback is the clamped alpha_init; the convergence
 // floor is relative to the data's scale, so very small pixel values are fitted like ordinary ones.
 // The fallback fit for vertices without a strictly usable sample (fit_vertex_weak, fit_status 4)
@@ -28,7 +28,7 @@ struct Sample {  // core/samples/samples.h Sample, 28 bytes
   float footprint;     // the normal variance over the photo's pixel footprint (samples/footprint.h)
 };
 
-struct Fit {  // core/fit/phong_fit.h VertexFit, 40 bytes
+struct Fit {  // core/fit/reflectance_fit.h VertexFit, 40 bytes
   float color[3];
   float kd, ks, shininess, dq, sq, rmse;
   uint bits;  // iterations | status << 16 | converged << 24
@@ -321,7 +321,7 @@ Linear solve(float alpha, bool ks_free) {
 // ---------------------------------------------------------------------------------------------
 // Output.
 
-// evaluate_phong() of the reference, in pixel units.
+// evaluate_reflectance() of the reference, in pixel units.
 vec3 evaluate(Fit f, float d, float s, float v) {
   d = max(d, 0.0);
   const float spec = (d > 0.0 && f.ks > 0.0) ? f.ks * lobe(s, f.shininess, v) : 0.0;

@@ -1,4 +1,4 @@
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -52,7 +52,7 @@ public:
   }
 
   // Exact non-negative least squares in (rho, k_s) for a fixed alpha (ks_free = false: k_s = 0).
-  Linear solve(double alpha, bool ks_free, const PhongFitOptions &o) const {
+  Linear solve(double alpha, bool ks_free, const ReflectanceFitOptions &o) const {
     double b = 0, g2 = 0, q[3] = {0, 0, 0};
     lobes_.resize(samples_.size());  // kept for the energy below: one exponential per sample
     const double a2 = ggx_a2(alpha);
@@ -133,7 +133,7 @@ private:
 };
 
 // Thesis 4.5-style initial shininess: ln(P - rho0 d) = ln k_s + alpha ln s over highlight samples.
-double alpha_from_highlights(const std::vector<FitSample> &samples, const double rho0[3], const PhongFitOptions &o) {
+double alpha_from_highlights(const std::vector<FitSample> &samples, const double rho0[3], const ReflectanceFitOptions &o) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int n = 0;
   for (const FitSample &x : samples) {
@@ -169,7 +169,7 @@ void quality_metrics(const std::vector<FitSample> &samples, const VertexFit &fit
   int nd = 0, ns = 0;
   for (const FitSample &x : samples) {
     float f[3];
-    evaluate_phong(fit, float(x.d), float(x.s), form, f, float(x.v));
+    evaluate_reflectance(fit, float(x.d), float(x.s), form, f, float(x.v));
     double err2 = 0;
     for (int c = 0; c < 3; ++c) err2 += (x.p[c] - f[c]) * (x.p[c] - f[c]);
     e += x.w * err2, w += x.w;
@@ -198,9 +198,9 @@ void store_linear(const Linear &L, double alpha, VertexFit &out) {
 } // namespace
 
 namespace {
-// The fit's usable samples (see phong_fit.h); returns the number of highlight samples.
+// The fit's usable samples (see reflectance_fit.h); returns the number of highlight samples.
 // `weak`: the fallback rules (fit_vertex_weak): grazing samples kept, mixed ones down-weighted.
-int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std::vector<FitSample> &samples,
+int usable_samples(const Sample *in, size_t count, const ReflectanceFitOptions &o, std::vector<FitSample> &samples,
                    double &w_high, double &w_other, bool weak = false) {
   samples.clear();
   samples.reserve(count);
@@ -229,7 +229,7 @@ int usable_samples(const Sample *in, size_t count, const PhongFitOptions &o, std
 }
 } // namespace
 
-void set_diffuse_only_reflectance(const Sample *in, size_t count, const PhongFitOptions &o, const float rho[3],
+void set_diffuse_only_reflectance(const Sample *in, size_t count, const ReflectanceFitOptions &o, const float rho[3],
                                   VertexFit &out) {
   std::vector<FitSample> samples;
   double w_high, w_other;
@@ -242,7 +242,7 @@ void set_diffuse_only_reflectance(const Sample *in, size_t count, const PhongFit
 }
 
 namespace {
-void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool weak, VertexFit &out) {
+void fit_vertex(const Sample *in, size_t count, const ReflectanceFitOptions &o, bool weak, VertexFit &out) {
   set_sentinels(out);
   std::vector<FitSample> samples;
   double w_high, w_other;
@@ -318,11 +318,11 @@ void fit_vertex(const Sample *in, size_t count, const PhongFitOptions &o, bool w
 }
 } // namespace
 
-void fit_vertex_cpu(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
+void fit_vertex_cpu(const Sample *in, size_t count, const ReflectanceFitOptions &o, VertexFit &out) {
   fit_vertex(in, count, o, false, out);
 }
 
-void fit_vertex_weak(const Sample *in, size_t count, const PhongFitOptions &o, VertexFit &out) {
+void fit_vertex_weak(const Sample *in, size_t count, const ReflectanceFitOptions &o, VertexFit &out) {
   fit_vertex(in, count, o, true, out);
   if (out.status == kFitNone) return;
   out.status = kFitFromWeakSamples;
@@ -330,7 +330,7 @@ void fit_vertex_weak(const Sample *in, size_t count, const PhongFitOptions &o, V
   out.sq *= 0.5f;
 }
 
-void recompute_fit_quality(const Sample *in, size_t count, const PhongFitOptions &o, bool weak, VertexFit &fit) {
+void recompute_fit_quality(const Sample *in, size_t count, const ReflectanceFitOptions &o, bool weak, VertexFit &fit) {
   std::vector<FitSample> samples;
   double w_high, w_other;
   usable_samples(in, count, o, samples, w_high, w_other, weak);
@@ -338,7 +338,7 @@ void recompute_fit_quality(const Sample *in, size_t count, const PhongFitOptions
   if (weak) fit.dq *= 0.5f, fit.sq *= 0.5f;
 }
 
-void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out) {
+void fit_chunk_cpu(const SampleChunk &chunk, const ReflectanceFitOptions &options, VertexFit *out) {
 #pragma omp parallel for schedule(dynamic, 256)
   for (long long i = 0; i < (long long)chunk.vertex_count; ++i) {
     const uint32_t begin = chunk.offsets[size_t(i)], end = chunk.offsets[size_t(i) + 1];

@@ -1,10 +1,10 @@
-// The per-vertex Phong model, evaluated per fragment: the one GLSL copy shared by the relight
+// The per-vertex reflectance model, evaluated per fragment: the one GLSL copy shared by the relight
 // renderer (core/relight/relight_render.cpp, the relight filter's images) and the live view
 // (core/relight/live_relight.cpp, MeshLab's "Vertex BRDF: relight" render plugin). Both programs
-// are "#version 330 core" + this file + their own main() (relight/phong_model_source.h); there is
+// are "#version 330 core" + this file + their own main() (relight/reflectance_model_source.h); there is
 // no #version here.
 //
-// Contract (the CPU's evaluate_phong, model/lobe.h, model/diffuse_form.h, term for term):
+// Contract (the CPU's evaluate_reflectance, model/lobe.h, model/diffuse_form.h, term for term):
 //   f = rho d + k_s g(s, alpha),  rho = k_d C,  unit irradiance; g = max(s, 0)^alpha, or GGX's
 //      D(N.H)/D(1) with a^2 = 2 / (alpha + 2) when u_ggx_lobe != 0 (model/lobe.h lobe_value),
 //      seen through the pixel's footprint: the normal's variance over one box pixel from the
@@ -13,7 +13,7 @@
 //   d: the diffuse factor, N.L (Lambert) or N.L T(max(N.L, 0.2)) T(max(N.E, 0.2)) / T(1)^2 (coated), per
 //      vertex (`coated` 1 or 0, DiffuseForms; blended linearly across a triangle that has both);
 //   s: the lobe's cosine, R.E with R = 2(N.L)N - L, or N.H when u_half_angle_lobe != 0;
-//   N.L <= 0: attached shadow, black (the callers test it before calling phong_terms).
+//   N.L <= 0: attached shadow, black (the callers test it before calling reflectance_terms).
 // Vertices with k_s = 0 carry the median shininess of the fitted lobes (chosen on the CPU), so
 // that a lobe fades with k_s across a triangle instead of widening.
 //
@@ -73,22 +73,22 @@ float pixel_footprint_variance(vec3 n) {
 // k_s g(s, alpha) for s > 0: s^alpha with the exponent's logarithm floored at kLobeLogFloor (no denormals,
 // no NaN), or the GGX lobe (a positive denominator for alpha >= 0) seen through a footprint of
 // normal variance v (model/lobe.h ggx_lobe_through_footprint: a_f^2 = min(a^2 + min(v, kMaxFootprintVariance), 1)).
-float phong_specular(float ks, float alpha, float s, float v) {
+float specular_term(float ks, float alpha, float s, float v) {
   if (!(ks > 0.0) || !(s > 0.0)) return 0.0;
   float c = min(s, 1.0);
   if (u_ggx_lobe != 0) {
     float a2 = 2.0 / (max(alpha, 0.0) + 2.0);
     float a2f = min(a2 + min(max(v, 0.0), kMaxFootprintVariance), 1.0);
     float den = a2f + (1.0 - c * c) * (1.0 - a2f);
-    return ks * a2 * a2f / (den * den);  // as phong_fit.comp's ggx_lobe and lobe.h
+    return ks * a2 * a2f / (den * den);  // as reflectance_fit.comp's ggx_lobe and lobe.h
   }
   return ks * exp(max(alpha * log(c), kLobeLogFloor));
 }
 
 // The model's two terms for unit n, l, e with N.L > 0: rho d and the specular (grey) value; v: the
 // pixel's footprint variance (pixel_footprint_variance).
-void phong_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, vec3 l, vec3 e, float v, out vec3 diffuse,
+void reflectance_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, vec3 l, vec3 e, float v, out vec3 diffuse,
                  out float specular) {
   diffuse = rho * diffuse_factor(dot(n, l), dot(n, e), coated);
-  specular = phong_specular(ks, alpha, lobe_cosine(n, l, e), v);
+  specular = specular_term(ks, alpha, lobe_cosine(n, l, e), v);
 }

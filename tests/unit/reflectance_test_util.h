@@ -4,12 +4,12 @@
 #include <random>
 #include <vector>
 
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 
 namespace vbrdf {
 namespace test {
 
-struct TruePhong {
+struct TrueReflectance {
   float rho[3];  // k_d * C
   float ks, alpha;
 };
@@ -17,7 +17,7 @@ struct TruePhong {
 // n samples: a third (at least `n_highlight` if given >= 0) near the specular peak
 // (s in [1 - 4/alpha, 1]), the rest spread over d in [0.1, 1], s in [-1, 0.9]; relative
 // Gaussian noise `noise` on every channel. Flags set as the gatherer would (T_s = 0.9).
-inline std::vector<Sample> synth_samples(const TruePhong &t, int n, float noise, std::mt19937 &rng,
+inline std::vector<Sample> synth_samples(const TrueReflectance &t, int n, float noise, std::mt19937 &rng,
                                          int n_highlight = -1) {
   std::uniform_real_distribution<float> u(0, 1);
   std::normal_distribution<float> gauss(0, 1);

@@ -1,6 +1,6 @@
 #pragma once
-// Per-vertex Phong fit: the contract shared by the CPU reference (phong_fit_cpu.cpp, double
-// precision, OpenMP) and the GPU back end (shaders/phong_fit.comp, float32).
+// Per-vertex reflectance fit: the contract shared by the CPU reference (reflectance_fit_cpu.cpp, double
+// precision, OpenMP) and the GPU back end (shaders/reflectance_fit.comp, float32).
 //
 // Model, per colour channel c, light of unit irradiance and white colour (after calibration):
 //     f_c = k_d d C_c + k_s g(s, alpha),  s = R.E or N.H, g = s^alpha or the GGX lobe (options.lobe,
@@ -38,12 +38,12 @@
 #include <cstdint>
 
 #include "model/defaults.h"
-#include "model/vertex_model.h"  // VertexFit, FitStatus, set_kd_color, evaluate_phong
+#include "model/vertex_model.h"  // VertexFit, FitStatus, set_kd_color, evaluate_reflectance
 #include "samples/samples.h"
 
 namespace vbrdf {
 
-struct PhongFitOptions {
+struct ReflectanceFitOptions {
   float alpha_init = kDefaultInitialShininess;  // initial shininess
   float alpha_min = kMinShininess;               // bounds on shininess
   float alpha_max = kMaxShininess;
@@ -67,28 +67,28 @@ struct PhongFitOptions {
 };
 
 // Fits one vertex from its samples (any flags: unusable ones are skipped). Double precision.
-void fit_vertex_cpu(const Sample *samples, size_t count, const PhongFitOptions &options, VertexFit &out);
+void fit_vertex_cpu(const Sample *samples, size_t count, const ReflectanceFitOptions &options, VertexFit &out);
 
 // The fallback fit for a vertex without any strictly usable sample: the same model and method,
 // over every lit, unsaturated sample with N.L > 0 (grazing ones with their N.L weight, mixed-pixel
 // ones at options.mixed_sample_weight). Status kFitFromWeakSamples, or kFitNone when even these
 // are absent (all shadowed or saturated). DQ and SQ are halved: weaker evidence than a strict fit.
-void fit_vertex_weak(const Sample *samples, size_t count, const PhongFitOptions &options, VertexFit &out);
+void fit_vertex_weak(const Sample *samples, size_t count, const ReflectanceFitOptions &options, VertexFit &out);
 
 // Fits every vertex of a chunk (OpenMP). `out` has chunk.vertex_count entries.
-void fit_chunk_cpu(const SampleChunk &chunk, const PhongFitOptions &options, VertexFit *out);
+void fit_chunk_cpu(const SampleChunk &chunk, const ReflectanceFitOptions &options, VertexFit *out);
 
 // Sets a diffuse-only result (k_s = 0) with diffuse reflectance rho = k_d C (normalised as above)
 // and recomputes DQ, SQ and RMSE from the vertex's samples. The pipeline uses it to give
 // diffuse-only vertices the robust basic colour estimate (diffuse_color.h) instead of the plain
 // weighted mean of the fit.
-void set_diffuse_only_reflectance(const Sample *samples, size_t count, const PhongFitOptions &options,
+void set_diffuse_only_reflectance(const Sample *samples, size_t count, const ReflectanceFitOptions &options,
                                   const float rho[3], VertexFit &out);
 
 // Recomputes DQ, SQ and RMSE of `fit` from the vertex's samples with the fit's usable-sample rules
 // (weak: the fallback rules of fit_vertex_weak, and DQ/SQ halved). The material stage
 // (materials.h) calls it after it changes k_s, alpha or k_d C. Parameters are not changed.
-void recompute_fit_quality(const Sample *samples, size_t count, const PhongFitOptions &options, bool weak,
+void recompute_fit_quality(const Sample *samples, size_t count, const ReflectanceFitOptions &options, bool weak,
                            VertexFit &fit);
 
 } // namespace vbrdf

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 #include <random>
 
-#include "fit/phong_fit.h"
-#include "phong_test_util.h"
+#include "fit/reflectance_fit.h"
+#include "reflectance_test_util.h"
 #include "thesis_settings.h"
 
 using namespace vbrdf;
@@ -17,7 +17,7 @@ enum Kind { kRandom, kAllEqual, kSingle, kAllGrazing, kSToZero, kSToOne, kDuplic
 
 std::vector<Sample> make_vertex(Kind kind, std::mt19937 &rng) {
   std::uniform_real_distribution<float> u(0, 1);
-  test::TruePhong t{{u(rng), u(rng), u(rng)}, u(rng) * 2, 1 + u(rng) * 999};
+  test::TrueReflectance t{{u(rng), u(rng), u(rng)}, u(rng) * 2, 1 + u(rng) * 999};
   const int n = 1 + int(u(rng) * 24);
   auto s = test::synth_samples(t, n, 0.05f * u(rng), rng);
   switch (kind) {
@@ -39,8 +39,8 @@ std::vector<Sample> make_vertex(Kind kind, std::mt19937 &rng) {
 bool within(float v, float lo, float hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 } // namespace
 
-TEST(PhongStress, MillionRandomAndDegenerateVertices) {
-  const PhongFitOptions o = vbrdf::test::thesis_fit_options();
+TEST(ReflectanceFitStress, MillionRandomAndDegenerateVertices) {
+  const ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   std::mt19937 rng(12345);
   const int n_vertices = 1000000;
   SampleChunk chunk;

@@ -1,15 +1,15 @@
 #pragma once
-// The shared Phong model shader (shaders/phong_model.glsl, embedded in the library) and what its
+// The shared reflectance model shader (shaders/reflectance_model.glsl, embedded in the library) and what its
 // users share on the CPU side: the relight renderer (relight_render.h) and the live view
-// (live_relight.h) build their fragment shaders as phong_program_source(their main), set the
-// model's uniforms with set_phong_model_uniforms, and draw the fit from one vertex buffer
-// (upload_phong_mesh; k_s = 0 vertices get typical_shininess).
+// (live_relight.h) build their fragment shaders as reflectance_program_source(their main), set the
+// model's uniforms with set_reflectance_model_uniforms, and draw the fit from one vertex buffer
+// (upload_model_mesh; k_s = 0 vertices get typical_shininess).
 #include <cstddef>
 #include <string>
 #include <vector>
 
 #include "base/mesh_view.h"
-#include "fit/phong_fit.h"
+#include "fit/reflectance_fit.h"
 #include "gl/gl_object.h"
 #include "model/diffuse_form.h"
 #include "model/lobe.h"
@@ -18,14 +18,14 @@ namespace vbrdf {
 
 struct GlApi;
 
-// "#version 330 core", the model's functions (phong_terms, diffuse_factor, lobe_cosine, ...), then
+// "#version 330 core", the model's functions (reflectance_terms, diffuse_factor, lobe_cosine, ...), then
 // `body` (#line directives keep compiler messages pointing into the right part). Throws
 // ProcessingError when the library was built without the embedded shader.
-std::string phong_program_source(const char *body);
+std::string reflectance_program_source(const char *body);
 
-// Sets phong_model.glsl's uniforms of `program` (which must be in use) for the fit's lobe form and
+// Sets reflectance_model.glsl's uniforms of `program` (which must be in use) for the fit's lobe form and
 // the coat's constants (the diffuse form is a per-vertex attribute of the callers).
-void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe);
+void set_reflectance_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe);
 
 // The shininess given to k_s = 0 vertices: the median of the fitted lobes (k_s > 0, alpha > 0,
 // finite), 1 when there is none.
@@ -41,13 +41,13 @@ float typical_shininess(const std::vector<VertexFit> &fits);
 // and the mesh's indices, recorded in a new vertex array object (left bound). `fits` and
 // `diffuse` have one entry per vertex.
 // The objects free themselves (GlObject).
-struct PhongMeshBuffers {
+struct ModelMeshBuffers {
   GlObject vao, vbo, ibo;
   size_t index_count = 0;
 };
-PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
+ModelMeshBuffers upload_model_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
                                    const std::vector<VertexFit> &fits, const DiffuseForms &diffuse);
-// Deletes what upload_phong_mesh created now (the context must be current) and zeroes `buffers`.
-void release_phong_mesh(const GlApi &gl, PhongMeshBuffers &buffers);
+// Deletes what upload_model_mesh created now (the context must be current) and zeroes `buffers`.
+void release_model_mesh(const GlApi &gl, ModelMeshBuffers &buffers);
 
 } // namespace vbrdf

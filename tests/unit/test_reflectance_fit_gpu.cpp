@@ -1,4 +1,4 @@
-// GPU Phong fit (phong_fit_gpu.h) in OSMesa against the double-precision CPU reference: agreement
+// GPU reflectance fit (reflectance_fit_gpu.h) in OSMesa against the double-precision CPU reference: agreement
 // on well-conditioned vertices (with the spread on the others reported), the degenerate-vertex
 // property test, 256-photo vertices, batching, GL state and malformed input.
 #include <gtest/gtest.h>
@@ -19,15 +19,15 @@
 #include "base/errors.h"
 #include "gl/gl_api.h"
 #include "osmesa_context.h"
-#include "fit/phong_fit.h"
-#include "fit/phong_fit_gpu.h"
-#include "phong_test_util.h"
+#include "fit/reflectance_fit.h"
+#include "fit/reflectance_fit_gpu.h"
+#include "reflectance_test_util.h"
 #include "thesis_settings.h"
 
 namespace vbrdf {
 namespace {
 
-using test::TruePhong;
+using test::TrueReflectance;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -47,7 +47,7 @@ void append_vertex(SampleChunk &chunk, const std::vector<Sample> &s) {
 // alpha 1-500 log-uniform, `n` samples (random 3-200 when n <= 0), noise 0-5 %, 0..n/2 highlights.
 std::vector<Sample> random_vertex(std::mt19937 &rng, int n = 0) {
   std::uniform_real_distribution<float> u(0, 1);
-  TruePhong t;
+  TrueReflectance t;
   const float kd = 0.02f + 0.98f * u(rng);
   const int main_channel = int(u(rng) * 3) % 3;
   for (int c = 0; c < 3; ++c) t.rho[c] = kd * (c == main_channel ? 1.0f : 0.2f + 0.8f * u(rng));
@@ -71,7 +71,7 @@ SampleChunk random_chunk(std::mt19937 &rng, int vertices, const std::function<vo
 }
 
 // Usable and highlight-usable sample counts under the contract's rule.
-void usable_counts(const SampleChunk &chunk, uint32_t v, const PhongFitOptions &o, int &n, int &n_high) {
+void usable_counts(const SampleChunk &chunk, uint32_t v, const ReflectanceFitOptions &o, int &n, int &n_high) {
   n = n_high = 0;
   for (uint32_t i = chunk.offsets[v]; i < chunk.offsets[v + 1]; ++i) {
     const Sample &s = chunk.samples[i];
@@ -131,7 +131,7 @@ bool well_posed(const VertexFit &cpu, int n, int n_high) {
 // 1e-3 is meaningful only where slack <= 1e-3.
 const double kMaxSlack = 1e-3;
 
-PhongFitOptions tightened(PhongFitOptions o) {
+ReflectanceFitOptions tightened(ReflectanceFitOptions o) {
   o.tolerance = 0;
   o.max_iterations = std::max(o.max_iterations, 300);
   return o;
@@ -152,7 +152,7 @@ struct Agreement {
 
 // `tight`: the CPU fits with tightened() options (empty: every well-posed vertex counts as
 // well-conditioned, e.g. under an iteration cap, where the cap and not the tolerance stops).
-Agreement compare(const SampleChunk &chunk, const PhongFitOptions &o, const std::vector<VertexFit> &gpu,
+Agreement compare(const SampleChunk &chunk, const ReflectanceFitOptions &o, const std::vector<VertexFit> &gpu,
                   const std::vector<VertexFit> &cpu, const std::vector<VertexFit> &tight, double tol,
                   int print_limit) {
   Agreement a;
@@ -189,8 +189,8 @@ Agreement compare(const SampleChunk &chunk, const PhongFitOptions &o, const std:
 
 bool within(float v, float lo, float hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 
-// Contract bounds and sentinels (as test_phong_stress.cpp).
-bool fit_in_bounds(const VertexFit &f, const PhongFitOptions &o) {
+// Contract bounds and sentinels (as test_reflectance_fit_stress.cpp).
+bool fit_in_bounds(const VertexFit &f, const ReflectanceFitOptions &o) {
   bool ok = within(f.kd, 0, o.kd_max) && within(f.ks, 0, o.ks_max) && within(f.dq, 0, 2) && within(f.sq, 0, 2) &&
             within(f.rmse, 0, FLT_MAX) && f.status <= kFitFull && f.converged <= 1;
   for (float c : f.color) ok &= within(c, 0, 1);
@@ -201,14 +201,14 @@ bool fit_in_bounds(const VertexFit &f, const PhongFitOptions &o) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Degenerate vertices (the kinds of test_phong_stress.cpp, plus extreme magnitudes).
+// Degenerate vertices (the kinds of test_reflectance_fit_stress.cpp, plus extreme magnitudes).
 
 enum Kind { kRandom, kAllEqual, kSingle, kAllGrazing, kSToZero, kSToOne, kDuplicateLights, kZeroPixels,
             kSaturatedOnly, kNaNSample, kHugeValues, kTinyValues, kExtremeValues, kInfNdotL, kKinds };
 
 std::vector<Sample> degenerate_vertex(Kind kind, std::mt19937 &rng) {
   std::uniform_real_distribution<float> u(0, 1);
-  TruePhong t{{u(rng), u(rng), u(rng)}, u(rng) * 2, 1 + u(rng) * 999};
+  TrueReflectance t{{u(rng), u(rng), u(rng)}, u(rng) * 2, 1 + u(rng) * 999};
   const int n = 1 + int(u(rng) * 24);
   auto s = test::synth_samples(t, n, 0.05f * u(rng), rng);
   switch (kind) {
@@ -239,7 +239,7 @@ SampleChunk degenerate_chunk(int vertices, unsigned seed) {
 
 // ---------------------------------------------------------------------------------------------
 
-class PhongFitGpuTest : public ::testing::Test {
+class ReflectanceFitGpuTest : public ::testing::Test {
 protected:
   void SetUp() override {
     std::string why;
@@ -247,10 +247,10 @@ protected:
     if (!context_) GTEST_SKIP() << "no OSMesa OpenGL context: " << why;
     if (context_->major_version() < 4 || (context_->major_version() == 4 && context_->minor_version() < 3))
       GTEST_SKIP() << "OSMesa gives OpenGL " << context_->version() << "; the GPU fit needs 4.3 compute shaders";
-    gpu_.reset(new PhongFitGpu(context_->get_proc_address()));
+    gpu_.reset(new ReflectanceFitGpu(context_->get_proc_address()));
   }
 
-  std::vector<VertexFit> run_gpu(const SampleChunk &chunk, const PhongFitOptions &o, double *secs = nullptr) {
+  std::vector<VertexFit> run_gpu(const SampleChunk &chunk, const ReflectanceFitOptions &o, double *secs = nullptr) {
     std::vector<VertexFit> out(chunk.vertex_count);
     const auto t0 = std::chrono::steady_clock::now();
     gpu_->fit_chunk(chunk, o, out.data());
@@ -258,7 +258,7 @@ protected:
     return out;
   }
 
-  static std::vector<VertexFit> run_cpu(const SampleChunk &chunk, const PhongFitOptions &o, double *secs = nullptr) {
+  static std::vector<VertexFit> run_cpu(const SampleChunk &chunk, const ReflectanceFitOptions &o, double *secs = nullptr) {
     std::vector<VertexFit> out(chunk.vertex_count);
     const auto t0 = std::chrono::steady_clock::now();
     fit_chunk_cpu(chunk, o, out.data());
@@ -268,7 +268,7 @@ protected:
 
   // How many of the vertices that `counted` picks the CPU fits differently (parameter_difference
   // above 1e-3) once `strip` has cleared a field of every sample: that the field matters to the fits.
-  static int vertices_changed_by(const SampleChunk &chunk, const PhongFitOptions &o,
+  static int vertices_changed_by(const SampleChunk &chunk, const ReflectanceFitOptions &o,
                                  const std::function<void(Sample &)> &strip,
                                  const std::function<bool(uint32_t)> &counted) {
     SampleChunk stripped = chunk;
@@ -283,7 +283,7 @@ protected:
   // the agreement; returns it for the caller's expectations.
   // `exponent`: the chunk's pixel values are 2^-exponent times ordinary ones (fits are compared
   // after scaling back).
-  Agreement agree(const SampleChunk &chunk, const PhongFitOptions &o, const char *label, bool cap_stops = false,
+  Agreement agree(const SampleChunk &chunk, const ReflectanceFitOptions &o, const char *label, bool cap_stops = false,
                   int exponent = 0) {
     double t_gpu = 0, t_cpu = 0;
     const auto gpu = rescaled(run_gpu(chunk, o, &t_gpu), exponent);
@@ -302,10 +302,10 @@ protected:
   }
 
   std::unique_ptr<test::OsMesaContext> context_;
-  std::unique_ptr<PhongFitGpu> gpu_;
+  std::unique_ptr<ReflectanceFitGpu> gpu_;
 };
 
-TEST_F(PhongFitGpuTest, AgreesWithCpuOnWellConditionedVertices) {
+TEST_F(ReflectanceFitGpuTest, AgreesWithCpuOnWellConditionedVertices) {
   std::mt19937 rng(7);
   SampleChunk chunk;
   for (int v = 0; v < 12000; ++v) append_vertex(chunk, random_vertex(rng));
@@ -315,21 +315,21 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuOnWellConditionedVertices) {
   EXPECT_LE(a.posed_disagree, a.posed / 200);  // all of them where the reference itself is loose
 }
 
-TEST_F(PhongFitGpuTest, AgreesWithCpuUnderOtherOptions) {
+TEST_F(ReflectanceFitGpuTest, AgreesWithCpuUnderOtherOptions) {
   std::mt19937 rng(8);
   SampleChunk chunk;
   for (int v = 0; v < 4000; ++v) append_vertex(chunk, random_vertex(rng));
-  PhongFitOptions no_remedies = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions no_remedies = vbrdf::test::thesis_fit_options();
   no_remedies.diffuse_prior = 0;
   no_remedies.specular_weight_cap = 1e9f;
   no_remedies.min_specular_samples = 1;
-  PhongFitOptions capped = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions capped = vbrdf::test::thesis_fit_options();
   capped.max_iterations = 2;
   capped.alpha_init = 50;
-  PhongFitOptions initial_only = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions initial_only = vbrdf::test::thesis_fit_options();
   initial_only.max_iterations = 0;
   const struct {
-    const PhongFitOptions *o;
+    const ReflectanceFitOptions *o;
     const char *label;
     bool cap_stops;
   } cases[] = {{&no_remedies, "no remedies", false},
@@ -344,17 +344,17 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuUnderOtherOptions) {
 
 // The half-angle (N.H) lobe: its thresholds and SQ term, and samples weighted by their photo's
 // resolution (Sample::resolution codes 0-31, as several cameras give), in both back ends alike.
-TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
+TEST_F(ReflectanceFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
   std::mt19937 rng(17);
   std::uniform_int_distribution<int> code(0, 31);
   const SampleChunk chunk =
       random_chunk(rng, 4000, [&](int v, Sample &x) { x.resolution = uint16_t(v % 2 ? code(rng) : 0); });
-  PhongFitOptions half_angle = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions half_angle = vbrdf::test::thesis_fit_options();
   half_angle.lobe = LobeForm::BlinnNH;
-  PhongFitOptions ggx = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions ggx = vbrdf::test::thesis_fit_options();
   ggx.lobe = LobeForm::GgxNH;
-  PhongFitOptions mirror = vbrdf::test::thesis_fit_options();  // R.E with resolution weights only
-  for (const PhongFitOptions *o : {&half_angle, &ggx, &mirror}) {
+  ReflectanceFitOptions mirror = vbrdf::test::thesis_fit_options();  // R.E with resolution weights only
+  for (const ReflectanceFitOptions *o : {&half_angle, &ggx, &mirror}) {
     const Agreement a = agree(chunk, *o, (std::string(lobe_form_label(o->lobe)) + " lobe, resolution weights").c_str());
     EXPECT_GT(a.well, 1000);
     EXPECT_LE(a.well_disagree, a.well / 200);
@@ -367,13 +367,13 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuForTheHalfAngleLobeAndResolutionWeights) {
 
 // The GGX lobe seen through each sample's pixel footprint (Sample::footprint, lobe.h), footprints
 // from none to past the clamp, in both back ends alike; and the footprint matters to the fits.
-TEST_F(PhongFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
+TEST_F(ReflectanceFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
   std::mt19937 rng(23);
   std::uniform_real_distribution<float> u(0, 1);
   const SampleChunk chunk = random_chunk(rng, 4000, [&](int v, Sample &x) {
     x.footprint = (v % 4 == 0 ? 0.0f : v % 4 == 1 ? 1e-3f : v % 4 == 2 ? 0.02f : 0.3f) * u(rng);
   });
-  PhongFitOptions ggx = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions ggx = vbrdf::test::thesis_fit_options();
   ggx.lobe = LobeForm::GgxNH;
   const Agreement a = agree(chunk, ggx, "GGX lobe through pixel footprints");
   EXPECT_GT(a.well, 1000);
@@ -383,7 +383,7 @@ TEST_F(PhongFitGpuTest, AgreesWithCpuThroughAPixelFootprint) {
   EXPECT_GT(differ, int(chunk.vertex_count) / 4);
 }
 
-TEST_F(PhongFitGpuTest, TwoHundredFiftySixPhotoVertices) {
+TEST_F(ReflectanceFitGpuTest, TwoHundredFiftySixPhotoVertices) {
   std::mt19937 rng(9);
   SampleChunk chunk;
   for (int v = 0; v < 3000; ++v) append_vertex(chunk, random_vertex(rng, 256));
@@ -392,8 +392,8 @@ TEST_F(PhongFitGpuTest, TwoHundredFiftySixPhotoVertices) {
   EXPECT_EQ(a.well_disagree, 0);
 }
 
-TEST_F(PhongFitGpuTest, DegenerateVerticesStayFiniteAndInBounds) {
-  const PhongFitOptions o = vbrdf::test::thesis_fit_options();
+TEST_F(ReflectanceFitGpuTest, DegenerateVerticesStayFiniteAndInBounds) {
+  const ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   const int sizes[] = {100000, 1000000};
   double last_secs = 0;
   const bool long_tests = std::getenv("VBRDF_LONG_TESTS") != nullptr;
@@ -423,7 +423,7 @@ TEST_F(PhongFitGpuTest, DegenerateVerticesStayFiniteAndInBounds) {
   }
 }
 
-TEST_F(PhongFitGpuTest, ExtremeMagnitudes) {
+TEST_F(ReflectanceFitGpuTest, ExtremeMagnitudes) {
   // Pixel values scaled by 2^100 / 2^-100: float squares would over/underflow without the
   // shader's power-of-two scaling. Large values: agreement with the CPU as usual. Tiny values:
   // the reference itself stops after one iteration there (its relative-gain floor
@@ -436,7 +436,7 @@ TEST_F(PhongFitGpuTest, ExtremeMagnitudes) {
   SampleChunk tiny = base, huge = base;
   for (Sample &s : tiny.samples) for (float &c : s.rgb) c = std::ldexp(c, -100);
   for (Sample &s : huge.samples) for (float &c : s.rgb) c = std::ldexp(c, 100);
-  PhongFitOptions o = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   o.kd_max = o.ks_max = FLT_MAX;  // let the magnitudes through the clamps
   const Agreement a = agree(huge, o, "pixel values x 2^100", false, -100);
   EXPECT_GT(a.well, 1000);
@@ -463,7 +463,7 @@ TEST_F(PhongFitGpuTest, ExtremeMagnitudes) {
   EXPECT_LT(kd_diff.quantile(0.95), 2e-3);
 }
 
-TEST_F(PhongFitGpuTest, ContractCornerCases) {
+TEST_F(ReflectanceFitGpuTest, ContractCornerCases) {
   // Two inputs on which the CPU reference breaks the contract (reported, not fixed there): the GPU
   // keeps it. (1) N.L = +Inf on one sample: the reference's k_d / rmse become NaN; here the sample
   // is not evidence. (2) alpha_init above alpha_max with a single usable highlight slope: the
@@ -475,7 +475,7 @@ TEST_F(PhongFitGpuTest, ContractCornerCases) {
   append_vertex(chunk, {{{0.18f, 0.18f, 0.18f}, 0.6f, 0.1f, 0, 0}, {{0.27f, 0.27f, 0.27f}, 0.9f, 0.3f, 0, 0},
                         {{0.15f, 0.15f, 0.15f}, 0.5f, 0.2f, 0, 0}, {{p + 1, p + 1, p + 1}, 0.9f, 1.0f, 0, kHighlight},
                         {{p + lobe, p + lobe, p + lobe}, 0.9f, 0.9995f, 0, kHighlight}});
-  PhongFitOptions o = vbrdf::test::thesis_fit_options();
+  ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   o.alpha_init = 5000;
   const auto fits = run_gpu(chunk, o);
   for (const VertexFit &f : fits) EXPECT_TRUE(fit_in_bounds(f, o)) << "kd " << f.kd << " alpha " << f.shininess;
@@ -484,11 +484,11 @@ TEST_F(PhongFitGpuTest, ContractCornerCases) {
   EXPECT_EQ(fits[1].shininess, o.alpha_max);
 }
 
-TEST_F(PhongFitGpuTest, BatchingGivesIdenticalResults) {
+TEST_F(ReflectanceFitGpuTest, BatchingGivesIdenticalResults) {
   std::mt19937 rng(11);
   SampleChunk chunk;
   for (int v = 0; v < 1000; ++v) append_vertex(chunk, random_vertex(rng, v == 500 ? 400 : 0));
-  const PhongFitOptions o = vbrdf::test::thesis_fit_options();
+  const ReflectanceFitOptions o = vbrdf::test::thesis_fit_options();
   const auto whole = run_gpu(chunk, o);
   EXPECT_EQ(gpu_->last_dispatch_count(), 1u);
   gpu_->set_batch_vertices(64);
@@ -499,7 +499,7 @@ TEST_F(PhongFitGpuTest, BatchingGivesIdenticalResults) {
   EXPECT_EQ(std::memcmp(whole.data(), split.data(), whole.size() * sizeof(VertexFit)), 0);
 }
 
-TEST_F(PhongFitGpuTest, EmptyVerticesAndChunksGiveSentinels) {
+TEST_F(ReflectanceFitGpuTest, EmptyVerticesAndChunksGiveSentinels) {
   SampleChunk chunk;
   std::mt19937 rng(12);
   append_vertex(chunk, {});
@@ -515,7 +515,7 @@ TEST_F(PhongFitGpuTest, EmptyVerticesAndChunksGiveSentinels) {
   gpu_->fit_chunk(SampleChunk(), vbrdf::test::thesis_fit_options(), nullptr);  // nothing to do
 }
 
-TEST_F(PhongFitGpuTest, MalformedChunksThrow) {
+TEST_F(ReflectanceFitGpuTest, MalformedChunksThrow) {
   std::mt19937 rng(13);
   SampleChunk chunk;
   append_vertex(chunk, random_vertex(rng, 10));
@@ -535,14 +535,14 @@ TEST_F(PhongFitGpuTest, MalformedChunksThrow) {
   EXPECT_NO_THROW(gpu_->fit_chunk(chunk, vbrdf::test::thesis_fit_options(), out.data()));  // still usable
 }
 
-TEST(PhongFitGpuCompatibility, RunsInACompatibilityContext) {
+TEST(ReflectanceFitGpuCompatibility, RunsInACompatibilityContext) {
   // MeshLab hands filters a compatibility-profile context.
   std::string why;
   auto context = test::OsMesaContext::try_create(&why, test::OsMesaContext::Profile::kCompatibility);
   if (!context) GTEST_SKIP() << "no OSMesa compatibility context: " << why;
   if (context->major_version() < 4 || (context->major_version() == 4 && context->minor_version() < 3))
     GTEST_SKIP() << "OSMesa gives OpenGL " << context->version() << "; the GPU fit needs 4.3 compute shaders";
-  PhongFitGpu gpu(context->get_proc_address());
+  ReflectanceFitGpu gpu(context->get_proc_address());
   std::mt19937 rng(15);
   SampleChunk chunk;
   for (int v = 0; v < 500; ++v) append_vertex(chunk, random_vertex(rng));
@@ -555,7 +555,7 @@ TEST(PhongFitGpuCompatibility, RunsInACompatibilityContext) {
   EXPECT_GE(close, int(chunk.vertex_count) * 95 / 100);
 }
 
-TEST_F(PhongFitGpuTest, LeavesGlBindingsAsFound) {
+TEST_F(ReflectanceFitGpuTest, LeavesGlBindingsAsFound) {
   const GlApi gl = load_gl_api(context_->get_proc_address());
   GLuint buffers[2] = {0, 0};
   gl.GenBuffers(2, buffers);

@@ -1,5 +1,5 @@
-// Assembly of the shared Phong model shader (contract in phong_model_source.h).
-#include "relight/phong_model_source.h"
+// Assembly of the shared reflectance model shader (contract in reflectance_model_source.h).
+#include "relight/reflectance_model_source.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,15 +10,15 @@
 
 namespace vbrdf {
 
-std::string phong_program_source(const char *body) {
-  const char *model = shaders::find("phong_model.glsl");
+std::string reflectance_program_source(const char *body) {
+  const char *model = shaders::find("reflectance_model.glsl");
   if (model == nullptr)
-    throw ProcessingError("The Phong model shader (phong_model.glsl) is not embedded in this build: rebuild the plugin.");
+    throw ProcessingError("The reflectance model shader (reflectance_model.glsl) is not embedded in this build: rebuild the plugin.");
   // #line <line> <source string>: 1 = the model, 2 = the caller's main.
   return std::string("#version 330 core\n#line 1 1\n") + model + "\n#line 1 2\n" + body;
 }
 
-void set_phong_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe) {
+void set_reflectance_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe) {
   gl.Uniform1i(gl.GetUniformLocation(program, "u_half_angle_lobe"), lobe != LobeForm::PhongRE ? 1 : 0);
   gl.Uniform1i(gl.GetUniformLocation(program, "u_ggx_lobe"), lobe == LobeForm::GgxNH ? 1 : 0);
   gl.Uniform1f(gl.GetUniformLocation(program, "u_coat_index"), kCoatIndex);
@@ -34,7 +34,7 @@ float typical_shininess(const std::vector<VertexFit> &fits) {
   return a[a.size() / 2];
 }
 
-PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
+ModelMeshBuffers upload_model_mesh(const GlApi &gl, const MeshView &mesh, const double origin[3],
                                    const std::vector<VertexFit> &fits, const DiffuseForms &diffuse) {
   constexpr int kFloats = 16;
   const float alpha_default = typical_shininess(fits);
@@ -55,7 +55,7 @@ PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const 
     o[14] = std::isfinite(f.dq) ? f.dq : 0.0f;
     o[15] = std::isfinite(f.sq) ? f.sq : 0.0f;
   }
-  PhongMeshBuffers b;
+  ModelMeshBuffers b;
   b.index_count = mesh.index_count;
   b.vao = GlObject::generate(gl, GlKind::VertexArray);
   gl.BindVertexArray(b.vao);
@@ -76,9 +76,9 @@ PhongMeshBuffers upload_phong_mesh(const GlApi &gl, const MeshView &mesh, const 
   return b;
 }
 
-void release_phong_mesh(const GlApi &, PhongMeshBuffers &b) {
+void release_model_mesh(const GlApi &, ModelMeshBuffers &b) {
   b.vao.reset(), b.vbo.reset(), b.ibo.reset();
-  b = PhongMeshBuffers();
+  b = ModelMeshBuffers();
 }
 
 } // namespace vbrdf
