@@ -5,7 +5,8 @@
 #    apt runs with a private list and state folder under build/deps2025/apt: the machine's own apt
 #    configuration is not changed. The entry is derived from the machine's own apt sources (same
 #    URI and keyring as its Debian entry, suite 'sid'); no host name is written anywhere.
-#  - a virtual environment build/venv-pymeshlab with pymeshlab==2025.7.post1 from PyPI.
+#  - a virtual environment build/venv-pymeshlab with pymeshlab==2025.7.post1 from PyPI, and
+#    PyQt5-Qt5==5.15.2 for its Qt platform plugins (OpenGL under xvfb-run: docs/pymeshlab.md#opengl).
 # Nothing of MeshLab, vcglib or the wheel is ever committed: all of it lives in the ignored build tree.
 # Exit status 0 when both are in place, 2 (with the reason on stderr) when one cannot be had
 # (no network, no Debian source URI): callers then skip the PyMeshLab tests.
@@ -15,6 +16,9 @@ DEPS="$ROOT/build/deps2025"
 SRC="$DEPS/meshlab-2025.07"
 VENV="$ROOT/build/venv-pymeshlab"
 PYMESHLAB_VERSION=2025.7.post1
+# Qt's platform plugins of the wheel's Qt (5.15.2), for OpenGL under a display or xvfb-run: the wheel
+# carries none, and Debian's (5.15.8) are refused by an older Qt.
+QT_PLATFORM_VERSION=5.15.2
 MESHLAB_ORIG=meshlab_2025.07~dfsg.orig.tar.xz
 
 # The URI and keyring of this machine's Debian archive entry (deb822 or one-line), "URI KEYRING".
@@ -77,13 +81,14 @@ fetch_meshlab_sources() {
 }
 
 make_venv() {
-  if [ -x "$VENV/bin/python" ] && "$VENV/bin/python" -c "import importlib.metadata as m; assert m.version('pymeshlab') == '$PYMESHLAB_VERSION'" 2>/dev/null; then
+  if [ -x "$VENV/bin/python" ] && "$VENV/bin/python" -c "import importlib.metadata as m; assert m.version('pymeshlab') == '$PYMESHLAB_VERSION' and m.version('PyQt5-Qt5') == '$QT_PLATFORM_VERSION'" 2>/dev/null; then
     return 0
   fi
   local python
   python=$(command -v python3)
   "$python" -m venv "$VENV" || { echo "setup-pymeshlab: '$python -m venv' failed (Debian: apt-get install python3-venv)." >&2; return 2; }
-  if ! "$VENV/bin/pip" install -q --disable-pip-version-check "pymeshlab==$PYMESHLAB_VERSION" numpy; then
+  if ! "$VENV/bin/pip" install -q --disable-pip-version-check --retries 2 --timeout 30 "pymeshlab==$PYMESHLAB_VERSION" numpy \
+       "PyQt5-Qt5==$QT_PLATFORM_VERSION"; then
     echo "setup-pymeshlab: cannot install pymeshlab==$PYMESHLAB_VERSION from PyPI (no network?)." >&2
     return 2
   fi

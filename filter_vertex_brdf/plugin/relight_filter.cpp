@@ -283,7 +283,9 @@ void RelightFilter::apply(FilterRun &run) const {
 
   GlContextScope gl(run.gl_context, log);
   if (!gl.get_proc())
-    throw vbrdf::ProcessingError("relighting needs OpenGL 3.3, and MeshLab gave no usable OpenGL context.");
+    throw vbrdf::ProcessingError("relighting needs OpenGL 3.3, and MeshLab gave no usable OpenGL context (in "
+                                 "PyMeshLab: set VBRDF_OPENGL=1 and run under a display or xvfb-run, "
+                                 "docs/pymeshlab.md#opengl).");
   vbrdf::RelightRenderer renderer(arrays.data.view(), fits, gl.get_proc(), s.render);
   std::vector<std::string> files;
   size_t replaced = s.novel_view && vbrdf::file_exists(vbrdf::join_path(s.output_folder, "novel_view.png"));
