@@ -18,7 +18,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Dict, Mapping, Optional, Union
 
-import pymeshlab
+
+def _qt_plugins_of_the_wheels_qt() -> None:
+    """Qt's plugins (image formats: JPEG, TIFF; platforms: OpenGL under a display) of the wheel's Qt
+    version, from PyQt5-Qt5 5.15.2 when installed beside pymeshlab: the wheel carries none. Set
+    before pymeshlab starts Qt; an explicit QT_PLUGIN_PATH is kept."""
+    import sysconfig
+    plugins = Path(sysconfig.get_paths()["purelib"]) / "PyQt5" / "Qt5" / "plugins"
+    if "QT_PLUGIN_PATH" not in os.environ and plugins.is_dir():
+        os.environ["QT_PLUGIN_PATH"] = str(plugins)
+
+
+_qt_plugins_of_the_wheels_qt()
+import pymeshlab  # noqa: E402  (after QT_PLUGIN_PATH)
 
 PathLike = Union[str, "os.PathLike[str]"]
 
