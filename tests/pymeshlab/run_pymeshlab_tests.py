@@ -48,7 +48,7 @@ def copy_project(project, dest):
     src = Path(project).resolve().parent
     if dest.exists():
         shutil.rmtree(dest)
-    shutil.copytree(src, dest, ignore=shutil.ignore_patterns("*_brdf.ply", "*_report.txt"))
+    shutil.copytree(src, dest, ignore=shutil.ignore_patterns("*_brdf.ply", "*_report.txt", "exr", "*.npz"))
     return dest / Path(project).name
 
 
@@ -150,7 +150,7 @@ def cmd_fit(args):
     ref_ply, new_ply = work / "meshlab2020_brdf.ply", work / "pymeshlab_brdf.ply"
     for p in (ref_ply, new_ply):
         p.unlink(missing_ok=True)
-    template = Path(args.project).resolve().parent / "fit.mlx"
+    template = Path(args.mlx) if args.mlx else Path(args.project).resolve().parent / "fit.mlx"
     backends = GPU if args.gl else CPU
     rc, log = run_2020(args.meshlabserver, project, template, dict(backends, outputPly=str(ref_ply)), work / "fit.mlx")
     if rc != 0 or not ref_ply.is_file():
@@ -250,7 +250,11 @@ def cmd_coverage(args):
     if rc != 0:
         print(log[-4000:])
         return finish("coverage", [f"meshlabserver 2020.09 failed (exit status {rc})"])
-    vbrdf.apply("coverage", b, **dict(vbrdf.script_parameters(template), **CPU_VISIBILITY))
+    # The 2020.09 script itself, through PyMeshLab's own script runner (no 'Project file': the
+    # plugin finds the project beside the mesh).
+    ms = vbrdf.open_project(b)
+    ms.load_filter_script(str(work / "coverage_cpu.mlx"))
+    ms.apply_filter_script()
     return finish("coverage", compare_outputs(a.parent, a_before, b.parent, b_before, MAX_REL))
 
 
@@ -348,6 +352,7 @@ def main():
     parser.add_argument("--work", required=True)
     parser.add_argument("--project")
     parser.add_argument("--meshlabserver")
+    parser.add_argument("--mlx", help="fit: the 2020.09 script whose values both sides use (default: the project's fit.mlx)")
     parser.add_argument("--gl", action="store_true",
                         help="fit: the GPU back ends (compute shaders) instead of the CPU ones")
     args = parser.parse_args()

@@ -1,8 +1,11 @@
 #include "filter_vertex_brdf_plugin.h"
 
 #include <cstdlib>
+#include <functional>
 #include <string>
 
+#include <QDir>
+#include <QFile>
 #include <QFileInfo>
 
 #include "filter_failure.h"
@@ -24,14 +27,39 @@ void add_project_file(RichParameterList &params) {
                              "document's own project, else the mesh file."));
 }
 
-// Gives the document the project's path as its label, where MeshLab's GUI and meshlabserver put it.
-void use_project_file(MeshDocument &md, const RichParameterList &params) {
-  if (!params.hasParameter(kProjectFile)) return;
-  const QString path = params.getString(kProjectFile);
-  if (path.isEmpty()) return;
+// The one .mlp beside the current mesh's file that names that file, else "": the project a script
+// most likely loaded when it did not say (PyMeshLab's load_project leaves no trace of it).
+QString project_beside_the_mesh(const MeshDocument &md) {
+  const MeshModel *mesh = md.mm();
+  if (mesh == nullptr || mesh->fullName().isEmpty()) return QString();
+  const QFileInfo mesh_file(mesh->fullName());
+  QString found;
+  for (const QFileInfo &candidate : mesh_file.absoluteDir().entryInfoList({"*.mlp"}, QDir::Files)) {
+    QFile file(candidate.absoluteFilePath());
+    if (!file.open(QIODevice::ReadOnly) || !file.readAll().contains(mesh_file.fileName().toUtf8())) continue;
+    if (!found.isEmpty()) return QString();  // two candidates: no guess
+    found = candidate.absoluteFilePath();
+  }
+  return found;
+}
+
+// Gives the document the project's path as its label, where MeshLab's GUI and meshlabserver put it:
+// the 'Project file' parameter, else the document's own label, else the one project beside the mesh.
+void use_project_file(MeshDocument &md, const RichParameterList &params,
+                      const std::function<void(const std::string &)> &log) {
+  const QString path = params.hasParameter(kProjectFile) ? params.getString(kProjectFile) : QString();
+  if (path.isEmpty()) {
+    if (!md.docLabel().isEmpty()) return;
+    const QString guess = project_beside_the_mesh(md);
+    if (guess.isEmpty()) return;
+    md.setDocLabel(guess);
+    log("Vertex BRDF: project file " + vbrdf_plugin::utf8(guess) + " (the one .mlp beside the mesh that names it; "
+        "set 'Project file' [projectFile] to choose another).");
+    return;
+  }
   const QFileInfo project(path);
   if (!project.isFile())
-    throw MLException("Project file '" + path + "' (" + kProjectFile + ") does not exist: give the path of the .mlp "
+    throw MLException("Project file '" + path + "' [" + kProjectFile + "] does not exist: give the path of the .mlp "
                       "the document was loaded from, or leave it empty.");
   md.setDocLabel(project.absoluteFilePath());
 }
@@ -97,7 +125,7 @@ std::map<std::string, QVariant> FilterVertexBrdfPlugin::applyFilter(const QActio
                                                                      unsigned int &postConditionMask,
                                                                      vcg::CallBackPos *cb) {
   const PluginFilter &filter = filterOf(action);
-  use_project_file(md, params);
+  use_project_file(md, params, [this](const std::string &line) { log(GLLogStream::FILTER, line); });
   std::map<std::string, QVariant> figures;
   vbrdf_plugin::FilterRun run{md, params, cb, glContext,
                               [this](GLLogStream::Levels level, const std::string &line) { log(level, line); },
