@@ -28,8 +28,6 @@ cv::Mat to_mat(const QImage &image, int type, int to_bgr_code) {
   return out;
 }
 
-bool has_alpha_channel(const QImage &image) { return image.hasAlphaChannel(); }
-
 bool is_sixteen_bit(QImage::Format format) {
   return format == QImage::Format_Grayscale16 || format == QImage::Format_RGBX64 || format == QImage::Format_RGBA64 ||
          format == QImage::Format_RGBA64_Premultiplied;
@@ -42,7 +40,7 @@ cv::Mat read_image_unchanged(const std::string &path) {
   reader.setAutoTransform(false);
   QImage image;
   if (!reader.read(&image) || image.isNull()) return cv::Mat();
-  const bool alpha = has_alpha_channel(image);
+  const bool alpha = image.hasAlphaChannel();
   if (is_sixteen_bit(image.format())) {
     if (image.isGrayscale() && !alpha) return to_mat(image.convertToFormat(QImage::Format_Grayscale16), CV_16UC1, -1);
     const QImage rgba = image.convertToFormat(QImage::Format_RGBA64);  // R, G, B, A in memory
