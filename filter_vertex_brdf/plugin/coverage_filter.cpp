@@ -59,8 +59,8 @@ QString CoverageFilter::info() const {
          "(log and a text file). Vertices only a new viewpoint can cover are selected.";
 }
 
-MeshFilterInterface::FilterClass CoverageFilter::filterClass() const {
-  return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::VertexColoring);
+host::FilterInterface::FilterClass CoverageFilter::filterClass() const {
+  return host::FilterInterface::FilterClass(host::FilterInterface::Camera | host::FilterInterface::VertexColoring);
 }
 
 int CoverageFilter::requirements() const { return MeshModel::MM_VERTCOLOR; }
@@ -164,12 +164,12 @@ vbrdf::CoverageResult CoverageFilter::run_on_document(FilterRun &run, vbrdf::Cov
   input.project_path = project_path(run.document, *mesh);
   settings.light_file = resolve_path(settings.light_file, input.project_path);
   settings.suggestion_file = resolve_path(settings.suggestion_file, input.project_path);
-  if (!run.document.rasterList.empty()) {
+  if (!host::rasters(run.document).empty()) {
     // viewpointRaster counts the document's rasters; the core counts the visible ones.
     const size_t chosen = shared::chosen_raster(run.document, settings.viewpoint_raster);
     const auto at = std::find(active.document_index.begin(), active.document_index.end(), chosen);
     require(at != active.document_index.end(), shared::kViewpointRaster,
-            "names raster " + std::to_string(chosen) + " ('" + utf8(run.document.rasterList[int(chosen)]->label()) +
+            "names raster " + std::to_string(chosen) + " ('" + utf8(host::rasters(run.document)[chosen]->label()) +
                 "'), which is hidden: show it in the layer dialog or choose a visible raster");
     settings.viewpoint_raster = int(at - active.document_index.begin());
   }

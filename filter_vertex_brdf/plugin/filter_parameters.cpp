@@ -36,10 +36,9 @@ void add_path(RichParameterList &params, const char *name, const QString &label,
 }
 
 std::string path(const RichParameterList &params, const char *name) {
-  const Value &value = params.getParameterByName(name).value();
-  if (value.isFileName()) return utf8(value.getFileName().trimmed());
-  require(value.isString(), name, "must be a path (text)");
-  return utf8(value.getString().trimmed());
+  QString text;
+  require(host::text_value(params.getParameterByName(name).value(), text), name, "must be a path (text)");
+  return utf8(text.trimmed());
 }
 
 std::string with_labels(const std::string &message, const RichParameterList &params) {
@@ -296,7 +295,7 @@ int viewpoint_raster(const RichParameterList &params) {
 }
 
 size_t chosen_raster(MeshDocument &document, int param) {
-  const int count = document.rasterList.size();
+  const int count = int(host::rasters(document).size());
   require(count > 0, kViewpointRaster, "needs a raster: the project has none");
   if (param >= 0) {
     require(param < count, kViewpointRaster,
@@ -304,7 +303,7 @@ size_t chosen_raster(MeshDocument &document, int param) {
                 " rasters (counted from 0; -1 = the current raster)");
     return size_t(param);
   }
-  const int current = document.rasterList.indexOf(document.rm());
+  const int current = host::current_raster_index(document);
   return size_t(current >= 0 ? current : count - 1);
 }
 
@@ -322,7 +321,7 @@ void add_sphere_outline(RichParameterList &params) {
 }
 
 vbrdf::SphereCircle sphere_outline(const RichParameterList &params, const char *x, const char *y, const char *r) {
-  const vbrdf::SphereCircle c{params.getFloat(x), params.getFloat(y), params.getFloat(r)};
+  const vbrdf::SphereCircle c{float(params.getFloat(x)), float(params.getFloat(y)), float(params.getFloat(r))};
   require(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.r) && c.r >= 0, r,
           "must be 0 (find the sphere automatically) or the sphere's radius in pixels (with a finite centre)");
   return c;

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include <common/interfaces.h>
+#include "meshlab_host.h"
 
 #include "core/calibration/color_chart.h"
 #include "core/inputs/photo.h"

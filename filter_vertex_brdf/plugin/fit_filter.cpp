@@ -52,8 +52,8 @@ QString FitFilter::info() const {
          "per-vertex value and a report. Hover over a field, or press Help, for what it does.";
 }
 
-MeshFilterInterface::FilterClass FitFilter::filterClass() const {
-  return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::VertexColoring);
+host::FilterInterface::FilterClass FitFilter::filterClass() const {
+  return host::FilterInterface::FilterClass(host::FilterInterface::Camera | host::FilterInterface::VertexColoring);
 }
 
 int FitFilter::requirements() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY; }
@@ -263,6 +263,14 @@ void FitFilter::apply(FilterRun &run) const {
           << ", colour correction: " << color_summary(settings, result) << "). Wrote " << result.output_ply << " ("
           << result.output_note << ")";
   log(summary.str());
+  if (run.figure) {
+    run.figure("vertices", double(arrays.vertex_index.size()));
+    run.figure("vertices_coloured", double(result.vertices_coloured));
+    run.figure("vertices_unseen", double(result.vertices_unseen));
+    run.figure("vertices_without_sample", double(result.vertices_no_diffuse));
+    run.figure("full_fits", double(result.fit_full));
+    run.figure("diffuse_only_fits", double(result.fit_diffuse_only));
+  }
 }
 
 } // namespace vbrdf_plugin

@@ -10,7 +10,7 @@ class FitFilter : public PluginFilter {
 public:
   QString name() const override;
   QString info() const override;
-  MeshFilterInterface::FilterClass filterClass() const override;
+  host::FilterInterface::FilterClass filterClass() const override;
   int requirements() const override;
   int preConditions() const override;
   int postConditions() const override;

@@ -54,9 +54,9 @@ bool qt_keeps_the_photos_depth(const std::string &path) {
 
 std::shared_ptr<const vbrdf::HostPhotos> host_photos(const MeshDocument &document) {
   auto photos = std::make_shared<vbrdf::HostPhotos>();
-  for (const RasterModel *rm : document.rasterList) {
+  for (const RasterModel *rm : host::rasters(document)) {
     if (rm == nullptr || rm->planeList.empty() || rm->planeList.first() == nullptr) continue;
-    const Plane &plane = *rm->planeList.first();
+    const host::RasterPlane &plane = *rm->planeList.first();
     const std::string path = utf8(plane.fullPathFileName);
     vbrdf::HostPixels pixels;
     if (qt_keeps_the_photos_depth(path) && host_pixels_of(plane.image, pixels)) (*photos)[path] = pixels;

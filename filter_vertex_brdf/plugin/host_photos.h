@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include <common/interfaces.h>
+#include "meshlab_host.h"
 
 #include "core/inputs/photo.h"
 

@@ -143,8 +143,8 @@ QString ImportPhotosFilter::info() const {
          "the most recently modified .lp beside the project or the photos that has an entry for every raster). Save the project (File &gt; Save Project) to keep the new rasters.";
 }
 
-MeshFilterInterface::FilterClass ImportPhotosFilter::filterClass() const {
-  return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::RasterLayer);
+host::FilterInterface::FilterClass ImportPhotosFilter::filterClass() const {
+  return host::FilterInterface::FilterClass(host::FilterInterface::Camera | host::FilterInterface::RasterLayer);
 }
 
 int ImportPhotosFilter::requirements() const { return MeshModel::MM_VERTCOLOR; }

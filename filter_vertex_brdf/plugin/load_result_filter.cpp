@@ -33,8 +33,8 @@ QString LoadResultFilter::info() const {
          "Vertex Quality Function</i> can compute from the attributes (e.g. <code>kd*2</code>).";
 }
 
-MeshFilterInterface::FilterClass LoadResultFilter::filterClass() const {
-  return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::VertexColoring);
+host::FilterInterface::FilterClass LoadResultFilter::filterClass() const {
+  return host::FilterInterface::FilterClass(host::FilterInterface::Camera | host::FilterInterface::VertexColoring);
 }
 
 int LoadResultFilter::requirements() const { return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY; }

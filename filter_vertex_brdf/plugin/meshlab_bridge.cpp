@@ -19,7 +19,7 @@ namespace {
 bool is_identity(const Matrix44m &m) {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c)
-      if (m[r][c] != (r == c ? 1.0f : 0.0f)) return false;
+      if (m[r][c] != (r == c ? 1 : 0)) return false;
   return true;
 }
 
@@ -64,16 +64,17 @@ MeshArrays mesh_arrays(const MeshModel &mesh) {
     if (v.IsD()) continue;
     array_index[i] = int64_t(out.vertex_index.size());
     out.vertex_index.push_back(i);
-    vcg::Point3f p = v.cP(), n = v.cN();
+    // In MeshLab's scalar (float in 2020.09, double in 2025.07); the core takes float.
+    Point3m p = v.cP(), n = v.cN();
     if (transformed) {
       p = cm.Tr * p;
-      vcg::Point4f n4 = normal_matrix * vcg::Point4f(n[0], n[1], n[2], 0.0f);
-      n = vcg::Point3f(n4[0], n4[1], n4[2]);
+      const vcg::Point4<Scalarm> n4 = normal_matrix * vcg::Point4<Scalarm>(n[0], n[1], n[2], 0);
+      n = Point3m(n4[0], n4[1], n4[2]);
       if (n.Norm() > 0) n.Normalize();
     }
     for (int k = 0; k < 3; ++k) {
-      out.data.positions.push_back(p[k]);
-      out.data.normals.push_back(n[k]);
+      out.data.positions.push_back(float(p[k]));
+      out.data.normals.push_back(float(n[k]));
     }
     if (n[0] != 0 || n[1] != 0 || n[2] != 0) any_normal = true;
     // Always present in CMeshO (white when never set); the colours from before our filters if saved.
@@ -110,7 +111,7 @@ vbrdf::Raster raster_of(const RasterModel &rm) {
                             ".mlp) or remove the raster.");
   // The first plane is the photo (MeshLab's .mlp reader keeps only the first).
   r.image_path = utf8(rm.planeList.first()->fullPathFileName);
-  r.shot = rm.shot;  // Shotm is vcg::Shot<float> with MESHLAB_SCALAR=float
+  r.shot = host::core_shot(rm.shot);
   return r;
 }
 
@@ -118,7 +119,7 @@ vbrdf::Raster raster_of(const RasterModel &rm) {
 
 std::vector<vbrdf::Raster> document_rasters(const MeshDocument &document) {
   std::vector<vbrdf::Raster> rasters;
-  for (const RasterModel *rm : document.rasterList) rasters.push_back(raster_of(*rm));
+  for (const RasterModel *rm : host::rasters(document)) rasters.push_back(raster_of(*rm));
   return rasters;
 }
 
@@ -126,9 +127,9 @@ void apply_corrected_cameras(MeshDocument &document, const vbrdf::RegistrationRe
                              const std::function<void(const std::string &)> &log) {
   if (!registration.any_applied()) return;
   size_t moved = 0;
-  for (RasterModel *rm : document.rasterList)
-    if (const vbrdf::Shot *corrected = registration.corrected_for(rm->shot)) {
-      rm->shot = *corrected;
+  for (RasterModel *rm : host::rasters(document))
+    if (const vbrdf::Shot *corrected = registration.corrected_for(host::core_shot(rm->shot))) {
+      rm->shot = host::host_shot(*corrected);
       ++moved;
     }
   log("Vertex BRDF: the corrected cameras were applied to " + std::to_string(moved) +
@@ -137,14 +138,15 @@ void apply_corrected_cameras(MeshDocument &document, const vbrdf::RegistrationRe
 
 ActiveRasters active_rasters(const MeshDocument &document) {
   ActiveRasters active;
-  for (int i = 0; i < document.rasterList.size(); ++i) {
-    const RasterModel *rm = document.rasterList[i];
-    if (!rm->visible) {
+  const std::vector<const RasterModel *> rasters = host::rasters(document);
+  for (size_t i = 0; i < rasters.size(); ++i) {
+    const RasterModel *rm = rasters[i];
+    if (!host::raster_visible(*rm)) {
       ++active.hidden;
       continue;
     }
     active.rasters.push_back(raster_of(*rm));
-    active.document_index.push_back(size_t(i));
+    active.document_index.push_back(i);
   }
   if (active.rasters.empty() && active.hidden > 0)
     throw vbrdf::InputError("Every raster (" + std::to_string(active.hidden) + ") is hidden in the layer dialog: only "
@@ -155,7 +157,8 @@ ActiveRasters active_rasters(const MeshDocument &document) {
 
 std::string project_path(const MeshDocument &document, const MeshModel &mesh) {
   // The document's file name is private in 2020.09; both meshlabserver and the GUI set the
-  // document label to the project's path when they open a project ("Project_N" otherwise).
+  // document label to the project's path when they open a project ("Project_N" otherwise). Under
+  // PyMeshLab the label is empty: the 2025.07 adapter sets it from the 'Project file' parameter.
   const QFileInfo project(document.docLabel());
   const QString suffix = project.suffix().toLower();
   if (project.isAbsolute() && project.isFile() && (suffix == "mlp" || suffix == "mlb"))
@@ -256,10 +259,10 @@ void apply_shading_normals(MeshModel &mesh, const MeshArrays &arrays, const std:
   to_local.transposeInPlace();
   for (size_t i = 0; i < n; ++i) {
     if (masked && !vertex_mask[i]) continue;
-    vcg::Point3f nw(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    Point3m nw(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
     if (arrays.transformed) {
-      const vcg::Point4f n4 = to_local * vcg::Point4f(nw[0], nw[1], nw[2], 0.0f);
-      nw = vcg::Point3f(n4[0], n4[1], n4[2]);
+      const vcg::Point4<Scalarm> n4 = to_local * vcg::Point4<Scalarm>(nw[0], nw[1], nw[2], 0);
+      nw = Point3m(n4[0], n4[1], n4[2]);
     }
     if (!(nw.Norm() > 0)) continue;
     cm.vert[arrays.vertex_index[i]].N() = nw.Normalize();
@@ -379,13 +382,13 @@ void select_vertices(MeshModel &mesh, const MeshArrays &arrays, const std::vecto
 void add_raster(MeshDocument &document, const std::string &image_path, const vbrdf::Shot &shot,
                 const std::string &label) {
   const QString path = QString::fromStdString(image_path);
-  std::unique_ptr<Plane> plane(new Plane(path, Plane::RGBA));  // loads the image
+  std::unique_ptr<host::RasterPlane> plane(new host::RasterPlane(path, host::RasterPlane::RGBA));  // loads the image
   if (plane->image.isNull())
     throw vbrdf::InputError("Photo '" + image_path + "' cannot be read as an image (missing, unreadable or of an "
                             "unsupported format): check the file.");
   RasterModel *raster = document.addNewRaster();
   raster->setLabel(QString::fromStdString(label));
-  raster->shot = shot;
+  raster->shot = host::host_shot(shot);
   raster->addPlane(plane.release());
 }
 

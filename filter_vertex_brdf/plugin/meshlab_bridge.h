@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include <common/interfaces.h>
+#include "meshlab_host.h"
 
 #include "core/inputs/camera.h"
 #include "core/base/mesh_view.h"

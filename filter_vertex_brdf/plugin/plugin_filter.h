@@ -6,7 +6,7 @@
 #include <functional>
 #include <string>
 
-#include <common/interfaces.h>
+#include "meshlab_host.h"
 
 namespace vbrdf_plugin {
 
@@ -18,6 +18,8 @@ struct FilterRun {
   vcg::CallBackPos *progress;          // may be null
   MLPluginGLContext *gl_context;       // may be null (no view): filters fall back to the CPU
   std::function<void(GLLogStream::Levels, const std::string &)> log;
+  // Numbers the host hands back to scripts (PyMeshLab's output dictionary); empty when it has none.
+  std::function<void(const std::string &, double)> figure;
 };
 
 class PluginFilter {
@@ -26,8 +28,8 @@ public:
   // Menu entry and .mlx name: never change it once released (scripts refer to it).
   virtual QString name() const = 0;
   virtual QString info() const = 0;  // HTML shown on top of the parameter dialog
-  virtual MeshFilterInterface::FilterClass filterClass() const = 0;
-  virtual MeshFilterInterface::FILTER_ARITY arity() const { return MeshFilterInterface::SINGLE_MESH; }
+  virtual host::FilterInterface::FilterClass filterClass() const = 0;
+  virtual host::FilterArity arity() const { return host::FilterInterface::SINGLE_MESH; }
   virtual int requirements() const { return MeshModel::MM_NONE; }
   virtual int preConditions() const { return MeshModel::MM_NONE; }
   virtual int postConditions() const = 0;

@@ -61,7 +61,7 @@ RelightFilter::Settings RelightFilter::settings_from(const RichParameterList &pa
   s.distance_scale = params.getFloat(kDistanceScale);
   require(std::isfinite(s.distance_scale) && s.distance_scale >= 0.05f && s.distance_scale <= 20, kDistanceScale,
           "must be in [0.05, 20]");
-  const vcg::Point3f light = params.getPoint3f(kNovelLight);
+  const vcg::Point3f light = host::direction_value(params, kNovelLight);
   require(std::isfinite(light.Norm()) && light.Norm() > 1e-6f, kNovelLight, "must be a non-zero direction");
   for (int k = 0; k < 3; ++k) s.novel_light[k] = light[k] / light.Norm();
   s.output.heat_map_max_de = params.getFloat(kHeatMapMax);
@@ -204,8 +204,8 @@ QString RelightFilter::info() const {
          "field, or press Help, for what it does.";
 }
 
-MeshFilterInterface::FilterClass RelightFilter::filterClass() const {
-  return MeshFilterInterface::FilterClass(MeshFilterInterface::Camera | MeshFilterInterface::Measure);
+host::FilterInterface::FilterClass RelightFilter::filterClass() const {
+  return host::FilterInterface::FilterClass(host::FilterInterface::Camera | host::FilterInterface::Measure);
 }
 
 int RelightFilter::preConditions() const { return MeshModel::MM_FACENUMBER; }
@@ -243,7 +243,7 @@ void RelightFilter::initParameters(const MeshDocument &, RichParameterList &para
   params.addParam(RichFloat(kDistanceScale, 1.0f, "Distance scale",
                             "Multiplies the novel camera's distance to the mesh centre (below 1: closer). "
                             "Range [0.05, 20]."));
-  params.addParam(RichPoint3f(kNovelLight, vcg::Point3f(0.0f, 0.0f, 1.0f), "Novel light direction",
+  params.addParam(host::direction_parameter(kNovelLight, vcg::Point3f(0.0f, 0.0f, 1.0f), "Novel light direction",
                               "Direction towards the light for the novel view, in that camera's frame: x right, y up, "
                               "z towards the viewer (0 0 1 = a light behind the camera)."));
   params.addParam(RichFloat(kHeatMapMax, 10.0f, "Heat map maximum (CIEDE2000)",
@@ -279,7 +279,9 @@ void RelightFilter::apply(FilterRun &run) const {
 
   GlContextScope gl(run.gl_context, log);
   if (!gl.get_proc())
-    throw vbrdf::ProcessingError("relighting needs OpenGL 3.3, and MeshLab gave no usable OpenGL context.");
+    throw vbrdf::ProcessingError("relighting needs OpenGL 3.3, and MeshLab gave no usable OpenGL context (in "
+                                 "PyMeshLab: set VBRDF_OPENGL=1 and run under a display or xvfb-run, "
+                                 "docs/pymeshlab.md#opengl).");
   vbrdf::RelightRenderer renderer(arrays.data.view(), fits, gl.get_proc(), s.render);
   std::vector<std::string> files;
   size_t replaced = s.novel_view && vbrdf::file_exists(vbrdf::join_path(s.output_folder, "novel_view.png"));

@@ -16,7 +16,7 @@ class RelightFilter : public PluginFilter {
 public:
   QString name() const override;
   QString info() const override;
-  MeshFilterInterface::FilterClass filterClass() const override;
+  host::FilterInterface::FilterClass filterClass() const override;
   int preConditions() const override;
   int postConditions() const override;
   void initParameters(const MeshDocument &document, RichParameterList &params) const override;

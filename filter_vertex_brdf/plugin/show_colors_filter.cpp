@@ -21,7 +21,7 @@ QString ShowColorsFilter::info() const {
          "last coverage run. The fit's \"keep the input colour\" always means the first of these, whatever is shown.";
 }
 
-MeshFilterInterface::FilterClass ShowColorsFilter::filterClass() const { return MeshFilterInterface::VertexColoring; }
+host::FilterInterface::FilterClass ShowColorsFilter::filterClass() const { return host::FilterInterface::VertexColoring; }
 
 int ShowColorsFilter::requirements() const { return MeshModel::MM_VERTCOLOR; }
 

@@ -10,7 +10,7 @@ class ShowColorsFilter : public PluginFilter {
 public:
   QString name() const override;
   QString info() const override;
-  MeshFilterInterface::FilterClass filterClass() const override;
+  host::FilterInterface::FilterClass filterClass() const override;
   int requirements() const override;
   int postConditions() const override;
   void initParameters(const MeshDocument &document, RichParameterList &params) const override;

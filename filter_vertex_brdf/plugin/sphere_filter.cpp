@@ -263,7 +263,7 @@ QString SphereFilter::info() const {
          "the project are not changed.";
 }
 
-MeshFilterInterface::FilterClass SphereFilter::filterClass() const { return MeshFilterInterface::Camera; }
+host::FilterInterface::FilterClass SphereFilter::filterClass() const { return host::FilterInterface::Camera; }
 
 int SphereFilter::postConditions() const { return MeshModel::MM_NONE; }
 

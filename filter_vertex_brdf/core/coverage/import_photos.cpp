@@ -8,11 +8,11 @@
 #include <dirent.h>
 #include <set>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "base/errors.h"
 #include "base/file_util.h"
 #include "calibration/sphere_lights.h"
+#include "inputs/image_codec.h"
 
 namespace vbrdf {
 
@@ -62,7 +62,7 @@ std::vector<LightEntry> sphere_light_entries(const std::vector<std::string> &pho
   std::vector<std::string> names;
   for (const std::string &p : photos) names.push_back(file_name_of(p));
   const GrayLoader load = [&photos](size_t i) {
-    const cv::Mat image = cv::imread(photos[i], cv::IMREAD_UNCHANGED);
+    const cv::Mat image = read_image_unchanged(photos[i]);
     if (image.empty()) throw InputError("Photo '" + photos[i] + "' cannot be read: check the file.");
     return gray_image(image, true);
   };

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "base/errors.h"
 #include "base/file_util.h"
+#include "inputs/image_codec.h"
 
 namespace vbrdf {
 
@@ -63,7 +63,7 @@ Photo load_photo(const std::string &path, PhotoEncoding encoding, float saturati
   Photo photo;
   photo.path = path;
   // Kept as decoded (BGR order): no conversion pass and no second copy of the photo.
-  photo.pixels = cv::imread(path, cv::IMREAD_UNCHANGED);
+  photo.pixels = read_image_unchanged(path);
   if (photo.pixels.empty()) throw InputError("Photo '" + path + "' cannot be decoded (unsupported or damaged file).");
   if (photo.pixels.depth() != CV_8U && photo.pixels.depth() != CV_16U)
     throw InputError("Photo '" + path + "' is neither 8- nor 16-bit per channel: convert it to 8-bit sRGB or "

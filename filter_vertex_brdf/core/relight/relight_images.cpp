@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "base/color_difference.h"
@@ -15,6 +14,7 @@
 #include "base/number_format.h"
 #include "base/file_util.h"
 #include "base/output_file.h"
+#include "inputs/image_codec.h"
 #include "base/vec3.h"
 
 namespace vbrdf {
@@ -146,7 +146,7 @@ cv::Mat contact_sheet(const std::vector<cv::Mat> &panels, int columns, int panel
 
 void write_png_atomically(const std::string &path, const cv::Mat &image) {
   std::vector<uint8_t> bytes;
-  if (image.empty() || !cv::imencode(".png", image, bytes))
+  if (!encode_png(image, bytes))
     throw ProcessingError("Cannot encode the image '" + path + "' as PNG.");
   write_text_file_atomically(path, std::string(bytes.begin(), bytes.end()));
 }

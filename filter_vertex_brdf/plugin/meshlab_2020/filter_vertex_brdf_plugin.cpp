@@ -1,10 +1,8 @@
 #include "filter_vertex_brdf_plugin.h"
 
-#include <exception>
 #include <string>
 
-#include "core/base/errors.h"
-#include "filter_parameters.h"
+#include "filter_failure.h"
 #include "plugin_filters.h"
 
 using vbrdf_plugin::PluginFilter;
@@ -57,22 +55,10 @@ bool FilterVertexBrdfPlugin::applyFilter(QAction *action, MeshDocument &md, cons
   const PluginFilter &filter = filterOf(action);
   errorMessage.clear();
   vbrdf_plugin::FilterRun run{md, params, cb, glContext,
-                              [this](GLLogStream::Levels level, const std::string &line) { Log(level, line); }};
-  std::string failure;
-  try {
-    filter.apply(run);
-    return true;
-  } catch (const vbrdf::InputError &e) {
-    failure = e.what();
-  } catch (const vbrdf::ProcessingError &e) {
-    failure = std::string("processing failed: ") + e.what();
-  } catch (const std::bad_alloc &) {
-    failure = "out of memory: lower 'memoryBudgetMB' or simplify the mesh";
-  } catch (const std::exception &e) {
-    failure = std::string("unexpected error: ") + e.what();
-  }
-  // Fields named as the dialog labels them (the .mlx name in brackets).
-  failure = vbrdf_plugin::with_labels(failure, params);
+                              [this](GLLogStream::Levels level, const std::string &line) { Log(level, line); },
+                              {}};
+  const std::string failure = vbrdf_plugin::apply_filter(filter, run);
+  if (failure.empty()) return true;
   errorMessage = QString::fromStdString(failure);
   // meshlabserver never prints errorMsg(), only the log: put the reason there too so that
   // headless runs say why they failed (the GUI shows errorMessage in its failure dialog).
