@@ -312,8 +312,10 @@ class Viewer {
   // column-major world->camera `view` and `projection` into a width x height float target and
   // returns its pixels, row 0 = top (the relight renderer's order).
   renderLinear(view, projection, width, height, light) {
+    // Float colour and a 32-bit float depth buffer, as the relight renderer's target.
+    const depthTexture = new THREE.DepthTexture(width, height, THREE.FloatType);
     const target = new THREE.WebGLRenderTarget(width, height, {
-      type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true,
+      type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: true, depthTexture,
       minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
     });
     const cam = new THREE.Camera();
