@@ -12,10 +12,10 @@ namespace vbrdf_plugin {
 namespace {
 
 // Parameter names (the .mlx scripts refer to them, never rename).
-const char *const kResultPly = "resultPly";
+const char *const kResultPly = "exportedResultPly";
 const char *const kOutputGlb = "outputGlb";
 const char *const kWriteViewer = "writeViewer";
-const char *const kOverwrite = "overwriteOutput";
+const char *const kOverwrite = "overwriteWebFiles";
 
 std::string without_extension(const std::string &path, const char *ext) {
   const size_t n = std::char_traits<char>::length(ext);
