@@ -12,7 +12,8 @@ PKGS=(build-essential cmake ninja-build pkg-config dpkg-dev
       qtbase5-dev libqt5opengl5-dev libqt5xmlpatterns5-dev
       libgl-dev libglu1-mesa-dev libglew-dev libeigen3-dev libglm-dev
       libopencv-dev libopencv-contrib-dev libosmesa6-dev
-      googletest libgtest-dev xvfb xauth meshlab python3 python3-numpy python3-venv)
+      googletest libgtest-dev xvfb xauth meshlab python3 python3-numpy python3-venv
+      libtinygltf-dev)
 
 missing=()
 for p in "${PKGS[@]}"; do

@@ -6,6 +6,9 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 BUILD="${VBRDF_BUILD_DIR:-$ROOT/build/release}"
 bash "$ROOT/.ci/setup-debian.sh" "$ROOT/build/deps"
+# The web viewer's packages (three.js, bundled at build time; the browser tests' driver and the glTF
+# validator) and the browser its tests run in (docs/web.md#checked-in-a-browser).
+bash "$ROOT/.ci/setup-web.sh"
 cmake -S "$ROOT" -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHLAB_SOURCE_DIR="$ROOT/build/deps/meshlab"
 cmake --build "$BUILD" -j"$(nproc)"
 # The PyMeshLab build (MeshLab 2025.07 sources from Debian, pymeshlab from PyPI): its tests (label

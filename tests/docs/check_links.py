@@ -133,7 +133,7 @@ def code_files(root):
     here = os.path.abspath(__file__)
     for top in SCAN_DIRS:
         for dirpath, dirnames, names in os.walk(os.path.join(root, top)):
-            dirnames[:] = [d for d in dirnames if not d.startswith(("build", "__pycache__"))]
+            dirnames[:] = [d for d in dirnames if not d.startswith(("build", "__pycache__")) and d != "node_modules"]
             for n in sorted(names):
                 full = os.path.join(dirpath, n)
                 ext = os.path.splitext(n)[1]
