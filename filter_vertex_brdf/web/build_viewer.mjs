@@ -4,7 +4,7 @@
 //   <out-dir>/viewer_template.html            the template (placeholders for the title and the GLB)
 //   <out-dir>/vbrdf_web_viewer_template.{h,cpp} the same text as a C++ constant (publish/web_viewer.h)
 // Run by the build (filter_vertex_brdf/web/CMakeLists.txt); by hand:
-//   node build_viewer.mjs --model-glsl ../../shaders/phong_model.glsl --out-dir /tmp/viewer
+//   node build_viewer.mjs --model-glsl ../../shaders/reflectance_model.glsl --out-dir /tmp/viewer
 import { build } from 'esbuild';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';

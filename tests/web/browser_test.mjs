@@ -233,8 +233,8 @@ else console.log('network: no request but the page\'s own (file://, offline; hos
 // 7. The comparison can fail.
 if (process.env.VBRDF_WEB_MUTATIONS === '1') {
   const mutations = [
-    ['lobe term (alpha x 1.1)', 'specular = phong_specular(ks, alpha, lobe_cosine(n, l, e), v);',
-     'specular = phong_specular(ks, alpha * 1.1, lobe_cosine(n, l, e), v);'],
+    ['lobe term (alpha x 1.1)', 'specular = specular_term(ks, alpha, lobe_cosine(n, l, e), v);',
+     'specular = specular_term(ks, alpha * 1.1, lobe_cosine(n, l, e), v);'],
     ['diffuse term (x 1.02)', 'diffuse = rho * diffuse_factor(dot(n, l), dot(n, e), coated);',
      'diffuse = rho * (1.02 * diffuse_factor(dot(n, l), dot(n, e), coated));'],
   ];

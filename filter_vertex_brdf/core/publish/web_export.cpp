@@ -17,8 +17,8 @@
 #include "io/result_schema.h"
 #include "publish/web_viewer.h"
 #include "relight/live_legend.h"  // the live view's false colours
-#include "relight/phong_model_source.h"  // typical_shininess: the renderers' rule for k_s = 0
-#include "samples/diffuse_form.h"
+#include "relight/reflectance_model_source.h"  // typical_shininess: the renderers' rule for k_s = 0
+#include "model/diffuse_form.h"
 
 namespace vbrdf {
 
@@ -197,7 +197,7 @@ WebGlb build_web_glb(const ResultPly &result, const std::string &path, const Web
   std::vector<float> color(3 * n), albedo(3 * n);
   for (size_t v = 0; v < n; ++v)
     for (int k = 0; k < 3; ++k) {
-      const float rho = fits[v].kd * fits[v].color[k];  // as upload_phong_mesh: float product
+      const float rho = fits[v].kd * fits[v].color[k];  // as upload_model_mesh: float product
       if (!std::isfinite(rho))
         throw InputError("Result '" + path + "': vertex " + std::to_string(v) +
                          "'s k_d C is not finite: a glTF file cannot carry it. Refit, or repair the file.");
@@ -245,7 +245,7 @@ WebGlb build_web_glb(const ResultPly &result, const std::string &path, const Web
   attrs["NORMAL"] = str("the shading normal the model was fitted with (the result's nx ny nz)");
   for (const ScalarAttribute &s : kScalars) attrs[s.gltf] = str(std::string(s.result) + ": " + meaning(s.result));
   Value::Object model;
-  model["model"] = str("f = k_d C d + k_s g(s, alpha), unit irradiance, linear RGB: shaders/phong_model.glsl");
+  model["model"] = str("f = k_d C d + k_s g(s, alpha), unit irradiance, linear RGB: shaders/reflectance_model.glsl");
   model["lobe_form"] = Value(int(out.lobe));
   model["lobe_form_name"] = str(lobe_form_name(out.lobe));
   model["diffuse_form"] = str(diffuse.varies() ? "per_vertex" :

@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "inputs/camera.h"
-#include "io/output_file.h"
+#include "base/output_file.h"
 #include "io/result_ply.h"
-#include "samples/lobe.h"
+#include "model/lobe.h"
 
 namespace vbrdf {
 
@@ -88,7 +88,7 @@ struct WebOutputPaths {
 WebOutputPaths web_output_paths(const std::string &glb_path);
 
 // Writes the GLB and, when `with_viewer`, both viewer pages (publish/web_viewer.h), each
-// atomically (io/output_file.h), after checking every path against `policy` (nothing is written
+// atomically (base/output_file.h), after checking every path against `policy` (nothing is written
 // when one is refused). Throws InputError (a refused or unwritable path; `with_viewer` in a build
 // without the viewer, with the remedy) or ProcessingError (I/O). Returns the paths written.
 WebOutputPaths write_web_outputs(const WebGlb &glb, const std::string &glb_path, bool with_viewer,

@@ -1,6 +1,6 @@
 #pragma once
 // The viewer page of a published fit: one self-contained HTML file (three.js, the viewer and the
-// product's GLSL model, shaders/phong_model.glsl, bundled at build time by
+// product's GLSL model, shaders/reflectance_model.glsl, bundled at build time by
 // filter_vertex_brdf/web/build_viewer.mjs into a template compiled into the library), with the GLB
 // either embedded (base64: opens from file:// with no server and no network) or loaded by URL
 // (the hosted variant, for a web server). Nothing is fetched from anywhere else at run time.

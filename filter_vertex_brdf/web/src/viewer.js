@@ -1,6 +1,6 @@
 // The Vertex BRDF web viewer: loads the GLB written by the exporter (embedded in the page, or by
 // URL in the hosted variant) with three.js's GLTFLoader and draws it with the product's model:
-// the fragment shader is the text of shaders/phong_model.glsl (put into the page verbatim at build
+// the fragment shader is the text of shaders/reflectance_model.glsl (put into the page verbatim at build
 // time, element #vbrdf-model-glsl) followed by this viewer's main(), as the relight renderer and
 // the live view each put their own main() after it. Nothing is fetched at run time but the GLB URL
 // of the hosted variant.
@@ -37,7 +37,7 @@ void main() {
   vec4 world = modelMatrix * vec4(position, 1.0);
   v_position = world.xyz;
   v_normal = normal;
-  // As upload_phong_mesh: fitted = fit_status != 0; k_s = 0 vertices take the median shininess.
+  // As upload_model_mesh: fitted = fit_status != 0; k_s = 0 vertices take the median shininess.
   v_rho_fitted = vec4(a_rho, a_fit_status > 0.5 ? 1.0 : 0.0);
   v_ks_alpha = vec2(a_ks, a_ks > 0.0 && a_shininess > 0.0 ? a_shininess : u_typical_shininess);
   v_coated = a_diffuse_form > 0.5 ? 1.0 : 0.0;
@@ -95,7 +95,7 @@ void main() {
     if (!(d > 0.0)) { o_color = vec4(0.0, 0.0, 0.0, 2.0); return; }
     vec3 diffuse;
     float spec;
-    phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
+    reflectance_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
     o_color = vec4(diffuse + vec3(spec), 1.0);
     return;
   }
@@ -124,13 +124,13 @@ void main() {
   if (!(d > 0.0)) { o_color = vec4(0.0, 0.0, 0.0, 1.0); return; }
   vec3 diffuse;
   float spec;
-  phong_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
+  reflectance_terms(v_rho_fitted.rgb, v_ks_alpha.x, v_ks_alpha.y, v_coated, n, l, e, footprint, diffuse, spec);
   vec3 c = u_mode == 2 ? vec3(spec) : diffuse + vec3(spec);
   o_color = vec4(srgb(c * u_exposure), 1.0);
 }
 `;
 
-// The model's uniforms as set_phong_model_uniforms sets them (lobe form from the GLB's extras).
+// The model's uniforms as set_reflectance_model_uniforms sets them (lobe form from the GLB's extras).
 function modelUniforms(model) {
   const lobe = model.lobe_form | 0;
   return {
