@@ -17,7 +17,7 @@
 // is not usable; the alpha_from_highlights fallback is the clamped alpha_init; the convergence
 // floor is relative to the data's scale, so very small pixel values are fitted like ordinary ones.
 // The fallback fit for vertices without a strictly usable sample (fit_vertex_weak, fit_status 4)
-// and the neighbour fill (fit_status 3) run on the CPU after either back end (core/fit/pipeline.cpp).
+// and the neighbour fill (fit_status 3) run on the CPU after either back end (core/run/fit_run.cpp).
 layout(local_size_x = 64) in;
 
 struct Sample {  // core/samples/samples.h Sample, 28 bytes

@@ -7,7 +7,6 @@
 #include "relight_filter.h"
 #include "show_colors_filter.h"
 #include "sphere_filter.h"
-#include "web_export_filter.h"
 
 namespace vbrdf_plugin {
 
@@ -20,7 +19,7 @@ std::vector<std::unique_ptr<PluginFilter>> make_plugin_filters() {
   filters.emplace_back(new ImportPhotosFilter());
   filters.emplace_back(new LoadResultFilter());
   filters.emplace_back(new ShowColorsFilter());
-  filters.emplace_back(new WebExportFilter());
+  add_host_filters(filters);
   return filters;
 }
 

@@ -11,4 +11,8 @@ namespace vbrdf_plugin {
 // Append new filters at the end: a filter's index is its FilterIDType.
 std::vector<std::unique_ptr<PluginFilter>> make_plugin_filters();
 
+// Appends the filters only this host's build offers, after the shared ones (defined by the host
+// adapter's folder: meshlab_<version>/host_filters.cpp).
+void add_host_filters(std::vector<std::unique_ptr<PluginFilter>> &filters);
+
 } // namespace vbrdf_plugin

@@ -1,7 +1,7 @@
 #include "web_export_filter.h"
 
 #include "core/base/errors.h"
-#include "core/fit/pipeline.h"
+#include "core/base/output_file.h"
 #include "core/publish/web_export.h"
 #include "core/publish/web_viewer.h"
 #include "filter_parameters.h"
@@ -35,7 +35,7 @@ QString WebExportFilter::info() const {
          "GLB. Generic glTF viewers show the albedo with a plain material.";
 }
 
-MeshFilterInterface::FilterClass WebExportFilter::filterClass() const { return MeshFilterInterface::Camera; }
+host::FilterInterface::FilterClass WebExportFilter::filterClass() const { return host::FilterInterface::Camera; }
 
 int WebExportFilter::postConditions() const { return MeshModel::MM_NONE; }
 

@@ -10,7 +10,7 @@ class WebExportFilter : public PluginFilter {
 public:
   QString name() const override;
   QString info() const override;
-  MeshFilterInterface::FilterClass filterClass() const override;
+  host::FilterInterface::FilterClass filterClass() const override;
   int postConditions() const override;
   void initParameters(const MeshDocument &document, RichParameterList &params) const override;
   void apply(FilterRun &run) const override;

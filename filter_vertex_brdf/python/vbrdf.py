@@ -35,7 +35,7 @@ import pymeshlab  # noqa: E402  (after QT_PLUGIN_PATH)
 PathLike = Union[str, "os.PathLike[str]"]
 
 PLUGIN_ENV = "VBRDF_PYMESHLAB_PLUGIN"
-_REPO = Path(__file__).resolve().parent.parent
+_REPO = Path(__file__).resolve().parents[2]  # filter_vertex_brdf/python/vbrdf.py
 DEFAULT_PLUGIN = _REPO / "build" / "pymeshlab" / "filter_vertex_brdf" / "plugin" / "libfilter_vertex_brdf.so"
 
 # The filters by their MeshLab names (menu entries, .mlx names); PyMeshLab's method names are

@@ -4,10 +4,13 @@
 # PyMeshLab loads filter and I/O plugins only.
 file(GLOB VBRDF_PLUGIN_SOURCES CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/*.h")
 set(VBRDF_HOST_DIR "${CMAKE_CURRENT_SOURCE_DIR}/meshlab_2025")
-# relight_attributes and photo_lights serve the 2020.09 render plugin only.
+# relight_attributes and photo_lights serve the 2020.09 render plugin only; the web export is
+# the 2020.09 build's (meshlab_2025/host_filters.cpp says why).
 list(REMOVE_ITEM VBRDF_PLUGIN_SOURCES
      "${CMAKE_CURRENT_SOURCE_DIR}/relight_attributes.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/relight_attributes.h"
-     "${CMAKE_CURRENT_SOURCE_DIR}/photo_lights.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/photo_lights.h")
+     "${CMAKE_CURRENT_SOURCE_DIR}/photo_lights.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/photo_lights.h"
+     "${CMAKE_CURRENT_SOURCE_DIR}/web_export_filter.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/web_export_filter.h")
+list(APPEND VBRDF_PLUGIN_SOURCES "${VBRDF_HOST_DIR}/host_filters.cpp")
 
 set(vbrdf_plugin_warnings -Wall -Wextra -Wno-unused-parameter -Wno-deprecated-copy -Wno-class-memaccess
     -Wno-ignored-qualifiers -Wno-deprecated-declarations -Wno-misleading-indentation)
