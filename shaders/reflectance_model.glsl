@@ -92,3 +92,10 @@ void reflectance_terms(vec3 rho, float ks, float alpha, float coated, vec3 n, ve
   diffuse = rho * diffuse_factor(dot(n, l), dot(n, e), coated);
   specular = specular_term(ks, alpha, lobe_cosine(n, l, e), v);
 }
+
+// A linear colour as the display shows it: clipped to [0, 1], then the sRGB transfer curve (the
+// live view and the web viewer encode with it).
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}

@@ -68,11 +68,6 @@ uniform float u_exposure;
 uniform int u_encode_srgb;
 layout(location = 0) out vec4 o_color;
 
-vec3 srgb(vec3 c) {
-  c = clamp(c, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
-
 void main() {
   float len = length(v_normal);
   vec3 n = len > 0.0 ? v_normal / len : v_normal;

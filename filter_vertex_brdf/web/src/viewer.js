@@ -69,10 +69,6 @@ uniform vec2 u_ks_range;
 uniform vec2 u_log_shininess_range;
 layout(location = 0) out vec4 o_color;
 
-vec3 srgb(vec3 c) {
-  c = clamp(c, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
 vec3 ramp(float t) {
   t = clamp(t, 0.0, 1.0);
   return t < 0.5 ? mix(u_ramp[0], u_ramp[1], 2.0 * t) : mix(u_ramp[1], u_ramp[2], 2.0 * t - 1.0);
