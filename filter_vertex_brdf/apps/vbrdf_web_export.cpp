@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "base/errors.h"
+#include "base/number_format.h"
 #include "inputs/project.h"
 #include "publish/web_export.h"
 #include "publish/web_viewer.h"
@@ -89,9 +90,9 @@ int main(int argc, char **argv) {
     const WebOutputPaths paths =
         write_web_outputs(glb, out, viewer, overwrite ? OverwritePolicy::Replace : OverwritePolicy::Refuse, title);
     std::printf("vbrdf-web-export: %s: %s\n", paths.glb.c_str(), glb.summary().c_str());
-    std::printf("  capture: %zu photo lights%s, %zu viewpoints%s%s\n", capture.lights.size(),
-                capture.light_file.empty() ? "" : (" from " + capture.light_file).c_str(), capture.cameras.size(),
-                capture.note.empty() ? "" : "; ", capture.note.c_str());
+    std::printf("  capture: %s%s, %s%s%s\n", counted(capture.lights.size(), "photo light").c_str(),
+                capture.light_file.empty() ? "" : (" from " + capture.light_file).c_str(),
+                counted(capture.cameras.size(), "viewpoint").c_str(), capture.note.empty() ? "" : "; ", capture.note.c_str());
     if (viewer) std::printf("  viewer: %s (opens from the file system), %s (beside the GLB on a server)\n",
                             paths.html.c_str(), paths.hosted_html.c_str());
     return 0;

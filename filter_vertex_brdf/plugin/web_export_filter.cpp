@@ -1,6 +1,7 @@
 #include "web_export_filter.h"
 
 #include "core/base/errors.h"
+#include "core/base/number_format.h"
 #include "core/base/output_file.h"
 #include "core/publish/web_export.h"
 #include "core/publish/web_viewer.h"
@@ -71,8 +72,8 @@ void WebExportFilter::apply(FilterRun &run) const {
       glb, glb_path, viewer, run.params.getBool(kOverwrite) ? vbrdf::OverwritePolicy::Replace : vbrdf::OverwritePolicy::Refuse,
       utf8(mesh->label()));
   std::string log = "Vertex BRDF: web export of " + file + ": " + paths.glb + ": " + glb.summary() + "; " +
-                    std::to_string(capture.lights.size()) + " photo lights, " + std::to_string(capture.cameras.size()) +
-                    " viewpoints" + (capture.note.empty() ? "" : " (" + capture.note + ")") + ".";
+                    vbrdf::counted(capture.lights.size(), "photo light") + ", " + vbrdf::counted(capture.cameras.size(), "viewpoint") +
+                    (capture.note.empty() ? "" : " (" + capture.note + ")") + ".";
   if (viewer) log += " Viewer: " + paths.html + " (opens from the file system), " + paths.hosted_html + " (beside the GLB on a web server).";
   run.log(GLLogStream::FILTER, log);
 }

@@ -30,6 +30,11 @@ inline std::string formatted(const char *format, double a = 0, double b = 0, dou
   return out;
 }
 
+// "1 viewpoint", "3 viewpoints": a count and its noun, plural with an "s" unless the count is 1.
+inline std::string counted(size_t n, const std::string &noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
 // Three significant digits, "%.3g": errors and scale labels.
 inline std::string three_significant(double v) { return formatted("%.3g", v); }
 

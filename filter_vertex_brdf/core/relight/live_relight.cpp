@@ -18,8 +18,9 @@ namespace {
 
 const char *const kWho = "Live relighting";
 
-// False colours are chosen per vertex and interpolated; the model is evaluated per fragment.
-const char *const kLiveVertexShader = R"(#version 330 core
+// False colours are chosen per vertex and interpolated; the model is evaluated per fragment. After
+// shaders/subpixel_grid.glsl: vertices on the 1/16-pixel grid, as the relight renderer puts them.
+const char *const kLiveVertexMain = R"(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
@@ -27,6 +28,7 @@ layout(location = 3) in vec3 a_ks_alpha_coated;
 layout(location = 4) in vec3 a_status_dq_sq;
 uniform mat4 u_modelview;
 uniform mat4 u_projection;
+uniform vec2 u_viewport;
 uniform int u_display;
 uniform vec3 u_status_colors[5];
 uniform vec3 u_quality_stops[3];
@@ -49,7 +51,7 @@ void main() {
   if (u_display == 3) v_false_color = u_status_colors[int(clamp(a_status_dq_sq.x, 0.0, 4.0) + 0.5)];
   else if (u_display == 4) v_false_color = quality_color(a_status_dq_sq.y);
   else v_false_color = quality_color(a_status_dq_sq.z);
-  gl_Position = u_projection * (u_modelview * vec4(a_position, 1.0));
+  gl_Position = snap_to_subpixel_grid(u_projection * (u_modelview * vec4(a_position, 1.0)), u_viewport);
 }
 )";
 
@@ -168,7 +170,7 @@ LiveRelight::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &fits
   GlStateGuard guard(gl_);
   clear_gl_errors(gl_);
   program_ = GlObject::adopt(gl_, GlKind::Program,
-                             build_program(gl_, kLiveVertexShader, reflectance_program_source(kLiveFragmentMain).c_str(),
+                             build_program(gl_, vertex_program_source(kLiveVertexMain).c_str(), reflectance_program_source(kLiveFragmentMain).c_str(),
                                            "the live relighting pass"));
   upload(mesh, fits);
   check_gl_error(gl_, "the upload of the mesh for live relighting");
@@ -221,6 +223,9 @@ void LiveRelight::Impl::draw(const LiveView &view) {
   gl_.UseProgram(p);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_modelview"), 1, GL_FALSE, mv);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, proj);
+  GLint viewport[4] = {0, 0, 1, 1};  // the host's (MeshLab's view) or render_offscreen's
+  gl_.GetIntegerv(GL_VIEWPORT, viewport);
+  gl_.Uniform2f(gl_.GetUniformLocation(p, "u_viewport"), float(std::max(viewport[2], 1)), float(std::max(viewport[3], 1)));
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), float(light[0]), float(light[1]), float(light[2]));
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_eye"), float(eye[0]), float(eye[1]), float(eye[2]));
   gl_.Uniform1i(gl_.GetUniformLocation(p, "u_eye_is_point"), perspective ? 1 : 0);

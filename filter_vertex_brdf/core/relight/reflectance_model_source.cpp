@@ -10,13 +10,22 @@
 
 namespace vbrdf {
 
-std::string reflectance_program_source(const char *body) {
-  const char *model = shaders::find("reflectance_model.glsl");
-  if (model == nullptr)
-    throw ProcessingError("The reflectance model shader (reflectance_model.glsl) is not embedded in this build: rebuild the plugin.");
-  // #line <line> <source string>: 1 = the model, 2 = the caller's main.
-  return std::string("#version 330 core\n#line 1 1\n") + model + "\n#line 1 2\n" + body;
+namespace {
+
+// "#version 330 core", the embedded shader `file`, then `body`; #line <line> <source string>:
+// 1 = the file, 2 = the caller's main.
+std::string program_source(const char *file, const char *body) {
+  const char *text = shaders::find(file);
+  if (text == nullptr)
+    throw ProcessingError(std::string("The shader ") + file + " is not embedded in this build: rebuild the plugin.");
+  return std::string("#version 330 core\n#line 1 1\n") + text + "\n#line 1 2\n" + body;
 }
+
+} // namespace
+
+std::string reflectance_program_source(const char *body) { return program_source("reflectance_model.glsl", body); }
+
+std::string vertex_program_source(const char *body) { return program_source("subpixel_grid.glsl", body); }
 
 void set_reflectance_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe) {
   gl.Uniform1i(gl.GetUniformLocation(program, "u_half_angle_lobe"), lobe != LobeForm::PhongRE ? 1 : 0);

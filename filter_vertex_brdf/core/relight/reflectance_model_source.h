@@ -23,6 +23,11 @@ struct GlApi;
 // ProcessingError when the library was built without the embedded shader.
 std::string reflectance_program_source(const char *body);
 
+// "#version 330 core", shaders/subpixel_grid.glsl (snap_to_subpixel_grid), then `body`: the vertex
+// shader of a renderer whose pixels are compared with another rasteriser's (the relight renderer's,
+// against the web viewer). Throws ProcessingError when the library was built without the shader.
+std::string vertex_program_source(const char *body);
+
 // Sets reflectance_model.glsl's uniforms of `program` (which must be in use) for the fit's lobe form and
 // the coat's constants (the diffuse form is a per-vertex attribute of the callers).
 void set_reflectance_model_uniforms(const GlApi &gl, unsigned program, LobeForm lobe);

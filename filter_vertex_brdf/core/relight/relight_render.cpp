@@ -30,15 +30,18 @@ namespace {
 
 const char *const kWho = "Relighting";  // starts its GL error messages
 
-// Shared by both passes: positions are uploaded relative to the bounding-box centre (precision of
-// far-from-origin coordinates), view depth is written for the shadow test and the comparison.
-const char *const kShadeVertexShader = R"(#version 330 core
+// The shading pass's main() (after shaders/subpixel_grid.glsl): positions are uploaded relative to
+// the bounding-box centre (precision of far-from-origin coordinates), view depth is written for the
+// comparison, the projected vertex goes on the 1/16-pixel grid (so that the web viewer's rasteriser
+// draws the same pixels, docs/web.md#checked-in-a-browser).
+const char *const kShadeVertexMain = R"(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec4 a_rho_fitted;
 layout(location = 3) in vec3 a_ks_alpha_coated;  // upload_model_mesh's layout (location 4 unused)
 uniform mat4 u_view;
 uniform mat4 u_projection;
+uniform vec2 u_viewport;
 out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_rho_fitted;
@@ -53,7 +56,7 @@ void main() {
   v_ks_alpha = a_ks_alpha_coated.xy;
   v_coated = a_ks_alpha_coated.z;
   v_depth = -view_pos.z;
-  gl_Position = u_projection * view_pos;
+  gl_Position = snap_to_subpixel_grid(u_projection * view_pos, u_viewport);
 }
 )";
 
@@ -176,7 +179,7 @@ RelightRenderer::Impl::Impl(const MeshView &mesh, const std::vector<VertexFit> &
   check_gl_target_size(gl_, settings_.shadow_map_size, settings_.shadow_map_size, kWho, "the shadow map");
   shade_program_ = GlObject::adopt(
       gl_, GlKind::Program,
-      build_program(gl_, kShadeVertexShader, reflectance_program_source(kShadeFragmentMain).c_str(), "the relighting pass"));
+      build_program(gl_, vertex_program_source(kShadeVertexMain).c_str(), reflectance_program_source(kShadeFragmentMain).c_str(), "the relighting pass"));
   shadow_program_ = GlObject::adopt(
       gl_, GlKind::Program,
       build_program(gl_, kLinearDepthVertexShader, kLinearDepthFragmentShader, "the relighting shadow map"));
@@ -255,6 +258,7 @@ void RelightRenderer::Impl::camera_pass(const Shot &shot, const LightSource &lig
   gl_.UseProgram(p);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_view"), 1, GL_FALSE, view.m);
   gl_.UniformMatrix4fv(gl_.GetUniformLocation(p, "u_projection"), 1, GL_FALSE, projection.m);
+  gl_.Uniform2f(gl_.GetUniformLocation(p, "u_viewport"), float(width), float(height));
   const float *d = light.direction.data();
   gl_.Uniform3f(gl_.GetUniformLocation(p, "u_light_dir"), d[0], d[1], d[2]);
   set_reflectance_model_uniforms(gl_, p, settings_.lobe);

@@ -15,8 +15,10 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
 const t0 = performance.now();
 const MODEL_GLSL = document.getElementById('vbrdf-model-glsl').textContent;
+// shaders/subpixel_grid.glsl (snap_to_subpixel_grid), as the relight renderer's vertex shader starts.
+const GRID_GLSL = document.getElementById('vbrdf-grid-glsl').textContent;
 
-const VERTEX_SHADER = `
+const VERTEX_SHADER = GRID_GLSL + `
 in vec3 a_rho;
 in float a_ks;
 in float a_shininess;
@@ -25,6 +27,7 @@ in float a_fit_status;
 in float a_dq;
 in float a_sq;
 uniform float u_typical_shininess;
+uniform vec2 u_viewport;
 out vec3 v_position;
 out vec3 v_normal;
 out vec4 v_rho_fitted;
@@ -44,7 +47,7 @@ void main() {
   v_status_dq_sq = vec3(a_fit_status, a_dq, a_sq);
   v_ks = a_ks;
   v_shininess = a_shininess;
-  gl_Position = projectionMatrix * viewMatrix * world;
+  gl_Position = snap_to_subpixel_grid(projectionMatrix * viewMatrix * world, u_viewport);
 }
 `;
 
@@ -230,6 +233,7 @@ class Viewer {
         ...modelUniforms(this.model),
         u_typical_shininess: { value: this.model.typical_shininess },
         u_light_dir: { value: this.lightDir },
+        u_viewport: { value: new THREE.Vector2(1, 1) },
         u_mode: { value: 0 },
         u_linear_output: { value: 0 },
         u_exposure: { value: 1 },
@@ -300,6 +304,7 @@ class Viewer {
     u.u_linear_output.value = 0;
     this.dots.visible = this.showLights;
     this.renderer.setRenderTarget(null);
+    this.renderer.getDrawingBufferSize(u.u_viewport.value);
     this.renderer.render(this.scene, this.camera);
     drawLightSphere(this);
   }
@@ -326,6 +331,7 @@ class Viewer {
     const saved = this.lightDir.clone();
     this.lightDir.set(light[0], light[1], light[2]).normalize();
     u.u_linear_output.value = 1;
+    u.u_viewport.value.set(width, height);
     const dots = this.dots.visible;
     this.dots.visible = false;
     this.renderer.setRenderTarget(target);
@@ -401,6 +407,9 @@ function lightFromDisc(v, x, y) {
   v.lightDir.copy(p.applyMatrix4(new THREE.Matrix4().extractRotation(v.camera.matrixWorld))).normalize();
 }
 
+// "1 viewpoint", "3 viewpoints".
+const counted = (n, noun) => `${n} ${noun}${n === 1 ? '' : 's'}`;
+
 function legendHtml(v) {
   const swatch = (e) => `<div class="row"><span class="swatch" style="background:${css(e.rgb)}"></span>${e.label}</div>`;
   const ramp = (lo, hi, label) =>
@@ -454,7 +463,7 @@ async function main() {
   document.getElementById('info').textContent =
     `${n.toLocaleString('en')} vertices, ${modelled.toLocaleString('en')} with a model\n` +
     `lobe ${v.model.lobe_form_name}, diffuse ${v.model.diffuse_form}\n` +
-    `${v.photoLights.length} photo lights, ${(v.capture.cameras || []).length} viewpoints\n` +
+    `${counted(v.photoLights.length, 'photo light')}, ${counted((v.capture.cameras || []).length, 'viewpoint')}\n` +
     `loaded in ${Math.round(v.loadMs)} ms`;
 
   // The light: drag on the sphere, or Shift (or Ctrl) + drag in the view.
