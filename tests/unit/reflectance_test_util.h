@@ -38,5 +38,34 @@ inline std::vector<Sample> synth_samples(const TrueReflectance &t, int n, float 
   return out;
 }
 
+// The kinds of degenerate vertex every fit back end must survive (the stress tests' inputs).
+enum DegenerateKind { kRandom, kAllEqual, kSingle, kAllGrazing, kSToZero, kSToOne, kDuplicateLights, kZeroPixels,
+                      kSaturatedOnly, kNaNSample, kHugeValues, kTinyValues, kExtremeValues, kInfNdotL, kDegenerateKinds };
+
+// One vertex's samples of `kind`: 1-24 samples of a random reflectance, then made degenerate.
+inline std::vector<Sample> degenerate_vertex(DegenerateKind kind, std::mt19937 &rng) {
+  std::uniform_real_distribution<float> u(0, 1);
+  TrueReflectance t{{u(rng), u(rng), u(rng)}, u(rng) * 2, 1 + u(rng) * 999};
+  const int n = 1 + int(u(rng) * 24);
+  auto s = synth_samples(t, n, 0.05f * u(rng), rng);
+  switch (kind) {
+  case kAllEqual: for (auto &x : s) x = s[0]; break;
+  case kSingle: s.resize(1); break;
+  case kAllGrazing: for (auto &x : s) x.d = 1e-4f * u(rng), x.flags |= kGrazing; break;
+  case kSToZero: for (auto &x : s) x.lobe_cos = 1e-30f * u(rng); break;
+  case kSToOne: for (auto &x : s) x.lobe_cos = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
+  case kDuplicateLights: for (auto &x : s) x.d = s[0].d, x.lobe_cos = s[0].lobe_cos; break;
+  case kZeroPixels: for (auto &x : s) x.rgb[0] = x.rgb[1] = x.rgb[2] = 0; break;
+  case kSaturatedOnly: for (auto &x : s) x.flags |= kSaturated; break;
+  case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().lobe_cos = std::nanf(""); break;
+  case kHugeValues: for (auto &x : s) x.rgb[0] *= 1e6f; break;
+  case kTinyValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e-30f; break;
+  case kExtremeValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e30f; break;  // squares overflow float
+  case kInfNdotL: s[0].d = INFINITY; break;
+  default: break;
+  }
+  return s;
+}
+
 } // namespace test
 } // namespace vbrdf

@@ -201,39 +201,16 @@ bool fit_in_bounds(const VertexFit &f, const ReflectanceFitOptions &o) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Degenerate vertices (the kinds of test_reflectance_fit_stress.cpp, plus extreme magnitudes).
+// Degenerate vertices (reflectance_test_util.h degenerate_vertex, as the CPU stress test uses them).
 
-enum Kind { kRandom, kAllEqual, kSingle, kAllGrazing, kSToZero, kSToOne, kDuplicateLights, kZeroPixels,
-            kSaturatedOnly, kNaNSample, kHugeValues, kTinyValues, kExtremeValues, kInfNdotL, kKinds };
-
-std::vector<Sample> degenerate_vertex(Kind kind, std::mt19937 &rng) {
-  std::uniform_real_distribution<float> u(0, 1);
-  TrueReflectance t{{u(rng), u(rng), u(rng)}, u(rng) * 2, 1 + u(rng) * 999};
-  const int n = 1 + int(u(rng) * 24);
-  auto s = test::synth_samples(t, n, 0.05f * u(rng), rng);
-  switch (kind) {
-  case kAllEqual: for (auto &x : s) x = s[0]; break;
-  case kSingle: s.resize(1); break;
-  case kAllGrazing: for (auto &x : s) x.d = 1e-4f * u(rng), x.flags |= kGrazing; break;
-  case kSToZero: for (auto &x : s) x.lobe_cos = 1e-30f * u(rng); break;
-  case kSToOne: for (auto &x : s) x.lobe_cos = 1.0f - 1e-7f * u(rng), x.flags |= kHighlight; break;
-  case kDuplicateLights: for (auto &x : s) x.d = s[0].d, x.lobe_cos = s[0].lobe_cos; break;
-  case kZeroPixels: for (auto &x : s) x.rgb[0] = x.rgb[1] = x.rgb[2] = 0; break;
-  case kSaturatedOnly: for (auto &x : s) x.flags |= kSaturated; break;
-  case kNaNSample: s[0].rgb[1] = std::nanf(""), s.back().lobe_cos = std::nanf(""); break;
-  case kHugeValues: for (auto &x : s) x.rgb[0] *= 1e6f; break;
-  case kTinyValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e-30f; break;
-  case kExtremeValues: for (auto &x : s) for (float &c : x.rgb) c *= 1e30f; break;  // squares overflow float
-  case kInfNdotL: s[0].d = INFINITY; break;
-  default: break;
-  }
-  return s;
-}
+using test::degenerate_vertex;
+using test::DegenerateKind;
+using test::kDegenerateKinds;
 
 SampleChunk degenerate_chunk(int vertices, unsigned seed) {
   std::mt19937 rng(seed);
   SampleChunk chunk;
-  for (int v = 0; v < vertices; ++v) append_vertex(chunk, degenerate_vertex(Kind(v % kKinds), rng));
+  for (int v = 0; v < vertices; ++v) append_vertex(chunk, degenerate_vertex(DegenerateKind(v % kDegenerateKinds), rng));
   return chunk;
 }
 
@@ -411,7 +388,7 @@ TEST_F(ReflectanceFitGpuTest, DegenerateVerticesStayFiniteAndInBounds) {
       const VertexFit &f = fits[size_t(v)];
       if (!fit_in_bounds(f, o) && bad++ < 5)
         std::printf("vertex %d (kind %d): kd %g ks %g a %g C %g %g %g dq %g sq %g rmse %g status %d\n", v,
-                    v % kKinds, f.kd, f.ks, f.shininess, f.color[0], f.color[1], f.color[2], f.dq, f.sq, f.rmse,
+                    v % kDegenerateKinds, f.kd, f.ks, f.shininess, f.color[0], f.color[1], f.color[2], f.dq, f.sq, f.rmse,
                     f.status);
       ++counts[std::min<int>(f.status, 2)];
     }
