@@ -26,8 +26,8 @@ namespace vbrdf {
 
 struct RegistrationSettings {
   // Off by default: on the synthetic captures of synthesize_scene, whose cameras are exact, the
-  // measurement reads up to 1.3 px (docs/method.md#registration-refined-from-the-photos); until that
-  // is understood it is the user's choice.
+  // measurement reads up to 1.3 px (open mesh borders and broad glossy lobes bias the Lambertian
+  // normal map: docs/method.md#registration-refined-from-the-photos), so it is the user's choice.
   bool enabled = false;
   // A viewpoint whose measured misregistration (RMS displacement of its visible vertices, pixels)
   // is below this keeps its camera: the estimate on exact cameras stays under it
