@@ -13,10 +13,13 @@ RBF fitted on the same training photos (per pixel: no camera and no mesh, so nei
 
 Prints one row per scene x capture x correction: relit CIEDE2000 mean / p95, PTM and RBF on the
 same samples, the misregistration the fit measured (camera captures) or how far the normals moved
-(median degrees), and the fit's run time. The exact capture runs with both steps on (the product).
+(median degrees), the fit's run time, and how far the input mesh's normals and the result's shading
+normals are from the renderer's own (median / p95 degrees over the vertices the truth sees and the
+fit models). The exact capture runs with both steps on (the product).
 Environment: VBRDF_FIT_OPTIONS, further vbrdf_fit options for every fit (e.g. "--deconvolve off").
 --max-ratio: exit 1 unless every perturbed capture with its correction on is within that ratio of
-the exact capture's mean and p95 and below PTM and RBF in both. Skips (exit 0) without the shared
+the exact capture's mean and p95 and below PTM and RBF in both, and the refined normals of every
+smoothed mesh closer to the truth than the mesh's in median and p95. Skips (exit 0) without the shared
 scenes.
 """
 import argparse
@@ -70,6 +73,42 @@ def gt_lit(scene_dir, out):
     return []
 
 
+NORMALS_VS_TRUTH = """
+import sys
+import numpy as np
+sys.path.insert(0, sys.argv[4])
+import e2e_lib
+def unit(a):
+    return a / np.maximum(np.linalg.norm(a, axis=1, keepdims=True), 1e-12)
+fit = e2e_lib.read_ply(sys.argv[1]).vertex
+mesh = e2e_lib.read_ply(sys.argv[2]).vertex
+gt = np.load(sys.argv[3])
+truth = unit(gt["normals"].astype(np.float64))
+if len(fit) != len(truth) or len(mesh) != len(truth):
+    sys.exit(0)
+keep = gt["visible"].astype(bool) & (fit["fit_status"] != 0)
+def angles(v):
+    n = unit(np.stack([v["nx"], v["ny"], v["nz"]], axis=1).astype(np.float64))
+    a = np.degrees(np.arccos(np.clip(np.sum(n * truth, axis=1), -1, 1)))[keep]
+    return np.median(a), np.percentile(a, 95)
+m, f = angles(mesh), angles(fit)
+print(f"{m[0]:.2f} {m[1]:.2f} {f[0]:.2f} {f[1]:.2f}")
+"""
+
+
+def normals_vs_truth(result, mesh, scene_dir):
+    """Median and p95 angle (degrees) of the input mesh's normals and of the result's shading normals
+    from the renderer's own normals, over the vertices the ground truth sees and the fit models;
+    None without numpy or without a vertex-for-vertex correspondence."""
+    for python in (sys.executable, "/usr/bin/python3"):
+        p = subprocess.run([python, "-c", NORMALS_VS_TRUTH, result, mesh, os.path.join(scene_dir, "gt_vertex.npz"),
+                            os.path.join(REPO, "tests", "e2e")], capture_output=True, text=True)
+        if p.returncode == 0:
+            v = p.stdout.split()
+            return tuple(float(x) for x in v) if len(v) == 4 else None
+    return None
+
+
 def parse_eval(text):
     def row(label):
         m = re.search(re.escape(label) + r"\s+(\d+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)", text)
@@ -98,7 +137,8 @@ def main():
     captures = [c for c in CAPTURES if not args.captures or c[0] in args.captures]
     extra_fit_options = shlex.split(os.environ.get("VBRDF_FIT_OPTIONS", ""))
     rows, failures = [], []
-    print(f"{'scene':28} {'capture':16} {'correction':19} {'mean':>6} {'p95':>6}   {'PTM':>13} {'RBF':>13}  {'measured':>14}  fit s")
+    print(f"{'scene':28} {'capture':16} {'correction':19} {'mean':>6} {'p95':>6}   {'PTM':>13} {'RBF':>13}  {'measured':>14}  fit s"
+          "  normals from the truth, mesh -> result (median/p95 deg)")
     for scene in args.scenes:
         s = os.path.join(shared, "scenes", scene)
         lit = gt_lit(s, os.path.join(work, scene + "_gt_lit.txt"))
@@ -141,12 +181,15 @@ def main():
                             out + ".eval.log")
                 e = parse_eval(open(out + ".eval.log").read())
                 label = "both on" if not step else f"{step} {setting}"
+                truth = normals_vs_truth(out, mesh if mesh_args else os.path.join(s, "mesh.ply"), s)
+                truth_text = f"{truth[0]:.2f}/{truth[1]:.2f} -> {truth[2]:.2f}/{truth[3]:.2f}" if truth else ""
                 r = dict(scene=scene, capture=name, correction=label, mean=e["product"][0], p95=e["product"][1],
                          ptm_mean=e["ptm"][0], ptm_p95=e["ptm"][1], rbf_mean=e["rbf"][0], rbf_p95=e["rbf"][1],
-                         measured=measured, mesh_normals_off=moved_mesh, fit_seconds=round(secs, 2))
+                         measured=measured, mesh_normals_off=moved_mesh, normals_vs_truth=truth_text,
+                         fit_seconds=round(secs, 2))
                 rows.append(r)
                 print(f"{scene:28} {name:16} {label:19} {r['mean']:6.3f} {r['p95']:6.3f}   {r['ptm_mean']:5.3f} / {r['ptm_p95']:5.3f}"
-                      f" {r['rbf_mean']:5.3f} / {r['rbf_p95']:5.3f}  {measured:>14}  {secs:5.1f}", flush=True)
+                      f" {r['rbf_mean']:5.3f} / {r['rbf_p95']:5.3f}  {measured:>14}  {secs:5.1f}  {truth_text}", flush=True)
                 if not step:
                     exact = r
                 elif setting == "on" and args.max_ratio and exact:
@@ -155,6 +198,9 @@ def main():
                             failures.append(f"{scene} {name}: {k} {r[k]:.3f} above {args.max_ratio} x exact {exact[k]:.3f}")
                         if r[k] >= min(r["ptm_" + k], r["rbf_" + k]):
                             failures.append(f"{scene} {name}: {k} {r[k]:.3f} not below PTM / RBF")
+                    if "--smooth-normals" in mesh_args and truth and (truth[2] >= truth[0] or truth[3] >= truth[1]):
+                        failures.append(f"{scene} {name}: the refined normals are not closer to the truth than the mesh's "
+                                        f"(median / p95 {truth_text} deg)")
     if args.csv:
         with open(args.csv, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))

@@ -300,17 +300,23 @@ AlignmentResult align_to_normal_map(const std::vector<AlignmentPoint> &points, c
   for (const AlignmentPoint &p : points) radius += (p.x - c[0]) * (p.x - c[0]) + (p.y - c[1]) * (p.y - c[1]);
   radius = std::max(1.0, std::sqrt(radius / double(points.size())));
   const Problem pb{points, c, f, settings, radius};
+  // The coarse levels only bring the shift into the finest level's basin: evenly strided points do.
+  std::vector<AlignmentPoint> coarse_points;
+  const size_t stride = settings.max_coarse_points > 0 ? (points.size() + settings.max_coarse_points - 1) / settings.max_coarse_points : 1;
+  for (size_t i = 0; i < points.size(); i += std::max<size_t>(stride, 1)) coarse_points.push_back(points[i]);
+  const Problem coarse{coarse_points, c, f, settings, radius};
   const std::vector<int> free = {0, 1};  // pitch and yaw: the shift
   ImageWarp w;
   Level finest;
   for (size_t i = 0; i < settings.levels.size(); ++i) {
     const Level l = blurred_level(map, settings.levels[i]);
-    if (i + 1 == settings.levels.size()) {
+    const bool last = i + 1 == settings.levels.size();
+    if (last) {
       finest = l;
       size_t used = 0;
       out.cost_before = cost_of(pb, finest, ImageWarp(), used);
     }
-    out.iterations += solve_level(pb, l, free.data(), int(free.size()), w);
+    out.iterations += solve_level(last || coarse_points.size() < kMinPoints ? pb : coarse, l, free.data(), int(free.size()), w);
   }
   if (settings.solve_roll_and_scale) {
     // Roll and scale, kept only where determined: solve them with the rest, test each against its

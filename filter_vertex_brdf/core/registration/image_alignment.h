@@ -37,6 +37,9 @@ struct AlignmentSettings {
   // shift) are solved on every level; roll and scale on the finest.
   std::vector<double> levels = {3.0, 1.5, 0.75};
   int iterations = 12;       // Gauss-Newton steps per level at most
+  // Points the coarse levels use (evenly strided; 0: all): they only bring the shift within the
+  // finest level's reach, which solves with every point.
+  size_t max_coarse_points = 5000;
   // Normal residual (unit vectors) beyond which a point's weight falls as 1/r: 0.1 keeps the estimate
   // on exact cameras within 0.07 px on the shared scenes (0.3: 0.11 px; docs/benchmark.md#real-captures-cameras-off-and-smoothed-normals).
   double huber = 0.1;

@@ -15,31 +15,64 @@ struct PixelNormal {
   bool determined = false;
 };
 
+// Whether the symmetric 3 x 3 matrix (a00 a01 a02; . a11 a12; . . a22) has its smallest eigenvalue
+// above `floor`: A - floor I positive definite, by its leading principal minors (Sylvester).
+bool smallest_eigenvalue_above(const Eigen::Matrix3d &a, double floor) {
+  const double m00 = a(0, 0) - floor, m11 = a(1, 1) - floor, m22 = a(2, 2) - floor;
+  const double m01 = a(0, 1), m02 = a(0, 2), m12 = a(1, 2);
+  const double minor2 = m00 * m11 - m01 * m01;
+  const double det = m00 * (m11 * m22 - m12 * m12) - m01 * (m01 * m22 - m12 * m02) + m02 * (m01 * m12 - m11 * m02);
+  return m00 > 0 && minor2 > 0 && det > 0;
+}
+
 // Least squares b over the samples with use[k]; not determined when fewer than min_samples or the
-// lights' spread is below min_light_spread (an ill-posed 3 x 3 system is never solved).
-PixelNormal solve_pixel(const std::vector<float> &I, const std::vector<Eigen::Vector3d> &L, const std::vector<char> &use,
-                        const NormalMapSettings &s) {
+// lights' spread is below min_light_spread (an ill-posed 3 x 3 system is never solved). LLt[k]:
+// the light's outer product L_k L_k^T.
+PixelNormal solve_pixel(const std::vector<float> &I, const std::vector<Eigen::Vector3d> &L,
+                        const std::vector<Eigen::Matrix3d> &LLt, const std::vector<char> &use, const NormalMapSettings &s) {
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d y = Eigen::Vector3d::Zero();
   int n = 0;
   for (size_t k = 0; k < I.size(); ++k) {
     if (!use[k]) continue;
-    A += L[k] * L[k].transpose();
+    A += LLt[k];
     y += double(I[k]) * L[k];
     ++n;
   }
   PixelNormal out;
   if (n < s.min_samples) return out;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(A / n, Eigen::EigenvaluesOnly);  // closed form: this runs once per pixel and round
-  if (!(eig.eigenvalues()(0) >= s.min_light_spread)) return out;
-  out.b = A.ldlt().solve(y);
+  if (!smallest_eigenvalue_above(A / n, s.min_light_spread)) return out;
+  out.b = A.llt().solve(y);
   out.determined = out.b.allFinite();
   return out;
 }
 
-PixelNormal robust_pixel(std::vector<float> &I, const std::vector<Eigen::Vector3d> &L, std::vector<char> &use,
-                         std::vector<float> &scratch, const NormalMapSettings &s) {
+// The (rank + 1)-th largest of `v` (rank < v.size()): a short sorted list of the largest for the
+// few highlights a pixel drops, a selection otherwise (reorders `v`).
+float largest(std::vector<float> &v, size_t rank) {
+  constexpr size_t kShort = 8;
+  if (rank >= kShort) {
+    std::nth_element(v.begin(), v.end() - 1 - std::ptrdiff_t(rank), v.end());
+    return v[v.size() - 1 - rank];
+  }
+  float top[kShort];  // descending
+  size_t n = 0;
+  for (const float x : v) {
+    if (n == rank + 1 && !(x > top[rank])) continue;
+    size_t i = std::min(n, rank);
+    while (i > 0 && top[i - 1] < x) {
+      top[i] = top[i - 1];
+      --i;
+    }
+    top[i] = x;
+    n = std::min(n + 1, rank + 1);
+  }
+  return top[rank];
+}
+
+PixelNormal robust_pixel(std::vector<float> &I, const std::vector<Eigen::Vector3d> &L,
+                         const std::vector<Eigen::Matrix3d> &LLt, std::vector<char> &use, std::vector<float> &scratch,
+                         const NormalMapSettings &s) {
   const size_t K = I.size();
   float brightest = 0;
   scratch.clear();
@@ -50,11 +83,10 @@ PixelNormal robust_pixel(std::vector<float> &I, const std::vector<Eigen::Vector3
     }
   if (scratch.size() < size_t(s.min_samples) || !(brightest > 0)) return PixelNormal();
   const size_t drop = size_t(std::floor(s.highlight_fraction * float(scratch.size())));
-  std::nth_element(scratch.begin(), scratch.end() - 1 - std::ptrdiff_t(drop), scratch.end());
-  const float highlight_above = scratch[scratch.size() - 1 - drop];
+  const float highlight_above = drop > 0 ? largest(scratch, drop) : brightest;
   for (size_t k = 0; k < K; ++k)
     use[k] = std::isfinite(I[k]) && I[k] >= s.shadow_floor * brightest && (drop == 0 || I[k] < highlight_above);
-  PixelNormal p = solve_pixel(I, L, use, s);
+  PixelNormal p = solve_pixel(I, L, LLt, use, s);
   for (int it = 0; it < s.iterations && p.determined; ++it) {
     const double norm_b = p.b.norm();
     scratch.clear();
@@ -63,12 +95,15 @@ PixelNormal robust_pixel(std::vector<float> &I, const std::vector<Eigen::Vector3
     std::nth_element(scratch.begin(), scratch.begin() + std::ptrdiff_t(scratch.size() / 2), scratch.end());
     // 3 robust sigmas (1.4826 MAD), never below 1 % of |b| (noise-free data would drop everything).
     const double limit = std::max(3.0 * 1.4826 * scratch[scratch.size() / 2], 0.01 * norm_b);
+    bool changed = false;
     for (size_t k = 0; k < K; ++k) {
-      if (!std::isfinite(I[k]) || I[k] <= 0) { use[k] = 0; continue; }
       const double predicted = L[k].dot(p.b);
-      use[k] = predicted > 0.05 * norm_b && std::fabs(I[k] - predicted) <= limit;
+      const char keep = std::isfinite(I[k]) && I[k] > 0 && predicted > 0.05 * norm_b && std::fabs(I[k] - predicted) <= limit;
+      changed |= keep != use[k];
+      use[k] = keep;
     }
-    const PixelNormal next = solve_pixel(I, L, use, s);
+    if (!changed) break;  // the same samples give the same solution: converged
+    const PixelNormal next = solve_pixel(I, L, LLt, use, s);
     if (!next.determined) break;
     p = next;
   }
@@ -89,7 +124,11 @@ NormalMap photometric_normal_map(const std::vector<cv::Mat> &luminance, const st
   map.weight = cv::Mat(roi.size(), CV_32F, cv::Scalar(0));
   cv::Mat albedo(roi.size(), CV_32F, cv::Scalar(0));
   std::vector<Eigen::Vector3d> L(lights.size());
-  for (size_t k = 0; k < lights.size(); ++k) L[k] = Eigen::Vector3d(lights[k][0], lights[k][1], lights[k][2]).normalized();
+  std::vector<Eigen::Matrix3d> LLt(lights.size());
+  for (size_t k = 0; k < lights.size(); ++k) {
+    L[k] = Eigen::Vector3d(lights[k][0], lights[k][1], lights[k][2]).normalized();
+    LLt[k] = L[k] * L[k].transpose();
+  }
 
 #pragma omp parallel
   {
@@ -101,7 +140,7 @@ NormalMap photometric_normal_map(const std::vector<cv::Mat> &luminance, const st
       float *w_row = map.weight.ptr<float>(y), *a_row = albedo.ptr<float>(y);
       for (int x = 0; x < roi.width; ++x) {
         for (size_t k = 0; k < luminance.size(); ++k) I[k] = luminance[k].ptr<float>(y)[x];
-        const PixelNormal p = robust_pixel(I, L, use, scratch, settings);
+        const PixelNormal p = robust_pixel(I, L, LLt, use, scratch, settings);
         if (!p.determined) continue;
         const double norm_b = p.b.norm();
         if (!(norm_b > 0)) continue;

@@ -33,7 +33,7 @@ struct NormalMapSettings {
   // A pixel whose scaled albedo |b| is below this fraction of the median over determined pixels is
   // background (normal 0, determined): silhouettes then register too.
   float background_level = 0.05f;
-  int iterations = 3;  // reweighting rounds after the first solve
+  int iterations = 3;  // reweighting rounds after the first solve, at most (it stops when the kept samples repeat)
 };
 
 // Photometric stereo over `luminance` (one CV_32F image per photo, all the size of `roi`, linear
