@@ -61,6 +61,13 @@ float lobe_cosine(vec3 n, vec3 l, vec3 e) {
   return dot(2.0 * dot(n, l) * n - l, e);
 }
 
+// The interpolated vertex normal made unit length (a zero normal stays zero). Every renderer's main()
+// starts with it and pixel_footprint_variance, in uniform control flow.
+vec3 unit_normal(vec3 interpolated) {
+  float len = length(interpolated);
+  return len > 0.0 ? interpolated / len : interpolated;
+}
+
 // The variance of the unit shading normal n over this fragment's pixel (a box: 1/12 pixel^2 per
 // axis) from its screen-space derivatives (samples/footprint.h). Call it in uniform control flow
 // (before any early return): derivatives are undefined elsewhere.

@@ -71,8 +71,7 @@ uniform int u_encode_srgb;
 layout(location = 0) out vec4 o_color;
 
 void main() {
-  float len = length(v_normal);
-  vec3 n = len > 0.0 ? v_normal / len : v_normal;
+  vec3 n = unit_normal(v_normal);
   float footprint = pixel_footprint_variance(n);
   vec3 l = u_light_dir;
   float d = dot(n, l);

@@ -93,10 +93,9 @@ float shadow_texel(int i, int j) {
 
 void main() {
   o_depth = v_depth;
+  vec3 n = unit_normal(v_normal);
+  float footprint = pixel_footprint_variance(n);  // before any return: derivatives need the whole quad
   if (v_rho_fitted.a < 0.999) { o_color = vec4(0.0, 0.0, 0.0, 3.0); return; }
-  float len = length(v_normal);
-  vec3 n = len > 0.0 ? v_normal / len : v_normal;
-  float footprint = pixel_footprint_variance(n);
   // Light direction and irradiance at the fragment (light_source.h): a point light's change
   // across the object, with the distance clamped as on the CPU.
   vec3 l = u_light_dir;

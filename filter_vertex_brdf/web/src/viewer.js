@@ -82,8 +82,7 @@ vec3 quality_color(float q) {
 }
 
 void main() {
-  float len = length(v_normal);
-  vec3 n = len > 0.0 ? v_normal / len : v_normal;
+  vec3 n = unit_normal(v_normal);
   float footprint = pixel_footprint_variance(n);
   vec3 l = u_light_dir;
   float d = dot(n, l);
