@@ -47,29 +47,6 @@ PixelNormal solve_pixel(const std::vector<float> &I, const std::vector<Eigen::Ve
   return out;
 }
 
-// The (rank + 1)-th largest of `v` (rank < v.size()): a short sorted list of the largest for the
-// few highlights a pixel drops, a selection otherwise (reorders `v`).
-float largest(std::vector<float> &v, size_t rank) {
-  constexpr size_t kShort = 8;
-  if (rank >= kShort) {
-    std::nth_element(v.begin(), v.end() - 1 - std::ptrdiff_t(rank), v.end());
-    return v[v.size() - 1 - rank];
-  }
-  float top[kShort];  // descending
-  size_t n = 0;
-  for (const float x : v) {
-    if (n == rank + 1 && !(x > top[rank])) continue;
-    size_t i = std::min(n, rank);
-    while (i > 0 && top[i - 1] < x) {
-      top[i] = top[i - 1];
-      --i;
-    }
-    top[i] = x;
-    n = std::min(n + 1, rank + 1);
-  }
-  return top[rank];
-}
-
 PixelNormal robust_pixel(std::vector<float> &I, const std::vector<Eigen::Vector3d> &L,
                          const std::vector<Eigen::Matrix3d> &LLt, std::vector<char> &use, std::vector<float> &scratch,
                          const NormalMapSettings &s) {
@@ -83,7 +60,11 @@ PixelNormal robust_pixel(std::vector<float> &I, const std::vector<Eigen::Vector3
     }
   if (scratch.size() < size_t(s.min_samples) || !(brightest > 0)) return PixelNormal();
   const size_t drop = size_t(std::floor(s.highlight_fraction * float(scratch.size())));
-  const float highlight_above = drop > 0 ? largest(scratch, drop) : brightest;
+  float highlight_above = brightest;
+  if (drop > 0) {
+    std::nth_element(scratch.begin(), scratch.end() - 1 - std::ptrdiff_t(drop), scratch.end());
+    highlight_above = scratch[scratch.size() - 1 - drop];
+  }
   for (size_t k = 0; k < K; ++k)
     use[k] = std::isfinite(I[k]) && I[k] >= s.shadow_floor * brightest && (drop == 0 || I[k] < highlight_above);
   PixelNormal p = solve_pixel(I, L, LLt, use, s);
