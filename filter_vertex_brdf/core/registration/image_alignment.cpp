@@ -302,9 +302,12 @@ AlignmentResult align_to_normal_map(const std::vector<AlignmentPoint> &points, c
   const Problem pb{points, c, f, settings, radius};
   // The coarse levels only bring the shift into the finest level's basin: evenly strided points do.
   std::vector<AlignmentPoint> coarse_points;
-  const size_t stride = settings.max_coarse_points > 0 ? (points.size() + settings.max_coarse_points - 1) / settings.max_coarse_points : 1;
-  for (size_t i = 0; i < points.size(); i += std::max<size_t>(stride, 1)) coarse_points.push_back(points[i]);
-  const Problem coarse{coarse_points, c, f, settings, radius};
+  const bool thin = settings.max_coarse_points > 0 && points.size() > settings.max_coarse_points;
+  if (thin) {
+    const size_t stride = (points.size() + settings.max_coarse_points - 1) / settings.max_coarse_points;
+    for (size_t i = 0; i < points.size(); i += stride) coarse_points.push_back(points[i]);
+  }
+  const Problem coarse{coarse_points.size() >= kMinPoints ? coarse_points : points, c, f, settings, radius};
   const std::vector<int> free = {0, 1};  // pitch and yaw: the shift
   ImageWarp w;
   Level finest;
@@ -316,7 +319,7 @@ AlignmentResult align_to_normal_map(const std::vector<AlignmentPoint> &points, c
       size_t used = 0;
       out.cost_before = cost_of(pb, finest, ImageWarp(), used);
     }
-    out.iterations += solve_level(last || coarse_points.size() < kMinPoints ? pb : coarse, l, free.data(), int(free.size()), w);
+    out.iterations += solve_level(last ? pb : coarse, l, free.data(), int(free.size()), w);
   }
   if (settings.solve_roll_and_scale) {
     // Roll and scale, kept only where determined: solve them with the rest, test each against its
