@@ -2,6 +2,7 @@
 //
 //   node browser_test.mjs --project P.mlp --work DIR --node-modules DIR --fit vbrdf_fit
 //                         --export vbrdf-web-export --reference vbrdf_web_reference --model-glsl FILE
+//                         --grid-glsl FILE
 //
 // Steps (each fails the test with the reason):
 //  1. fits the project (vbrdf_fit) and exports the result (vbrdf-web-export: GLB and both pages);
@@ -11,7 +12,7 @@
 //  4. opens the embedded page from file:// in Debian's chromium (headless, WebGL2 on SwiftShader),
 //     offline, with every request but the page's own blocked, and checks that it reports SwiftShader
 //     and that its GLSL model is the text of --model-glsl exactly, and its vertex grid the text of
-//     subpixel_grid.glsl beside it;
+//     --grid-glsl;
 //  5. renders 3 cameras x 8 lights into a float target (renderLinear) and compares them with the
 //     relight renderer's images at the same cameras and lights (vbrdf_web_reference render):
 //     pass when >= 99.9 % of the surface pixels are within one 8-bit sRGB level (exposure 1,
@@ -26,7 +27,7 @@
 import { spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync, copyFileSync } from 'node:fs';
 import { createServer } from 'node:http';
-import { join, basename, dirname } from 'node:path';
+import { join, basename } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { createRequire } from 'node:module';
 
@@ -41,7 +42,7 @@ const opt = (name, fallback) => {
 const project = opt('--project'), work = opt('--work'), nodeModules = opt('--node-modules');
 const fitTool = opt('--fit'), exportTool = opt('--export'), referenceTool = opt('--reference');
 const modelGlsl = opt('--model-glsl');
-const gridGlsl = join(dirname(modelGlsl), 'subpixel_grid.glsl');
+const gridGlsl = opt('--grid-glsl');
 const chromiumPath = process.env.VBRDF_CHROMIUM || '/usr/bin/chromium';
 const CAMERAS = Number(opt('--cameras', '3')), LIGHTS = Number(opt('--lights', '8')), WIDTH = Number(opt('--width', '0'));
 // Tolerance (docs/web.md#checked-in-a-browser): both renderers put their vertices on the same
