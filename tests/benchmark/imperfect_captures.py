@@ -63,14 +63,20 @@ with open(sys.argv[2], "w") as f:
 """
 
 
+def run_with_numpy(script, args):
+    """Runs `script` with this interpreter or, failing that, Debian's (which has numpy); its standard
+    output, or None when neither ran it."""
+    for python in (sys.executable, "/usr/bin/python3"):
+        p = subprocess.run([python, "-c", script] + args, capture_output=True, text=True)
+        if p.returncode == 0:
+            return p.stdout
+    return None
+
+
 def gt_lit(scene_dir, out):
     """The ground truth's held-out lit flags as vbrdf_eval --gt-lit reads them (as whole_surface_eval.sh
     does), with Debian's numpy; without it the evaluation uses its own shadow passes and says so."""
-    for python in (sys.executable, "/usr/bin/python3"):
-        if subprocess.call([python, "-c", GT_LIT, os.path.join(scene_dir, "gt_vertex.npz"), out],
-                           stderr=subprocess.DEVNULL) == 0:
-            return ["--gt-lit", out]
-    return []
+    return ["--gt-lit", out] if run_with_numpy(GT_LIT, [os.path.join(scene_dir, "gt_vertex.npz"), out]) is not None else []
 
 
 NORMALS_VS_TRUTH = """
@@ -100,13 +106,10 @@ def normals_vs_truth(result, mesh, scene_dir):
     """Median and p95 angle (degrees) of the input mesh's normals and of the result's shading normals
     from the renderer's own normals, over the vertices the ground truth sees and the fit models;
     None without numpy or without a vertex-for-vertex correspondence."""
-    for python in (sys.executable, "/usr/bin/python3"):
-        p = subprocess.run([python, "-c", NORMALS_VS_TRUTH, result, mesh, os.path.join(scene_dir, "gt_vertex.npz"),
-                            os.path.join(REPO, "tests", "e2e")], capture_output=True, text=True)
-        if p.returncode == 0:
-            v = p.stdout.split()
-            return tuple(float(x) for x in v) if len(v) == 4 else None
-    return None
+    out = run_with_numpy(NORMALS_VS_TRUTH, [result, mesh, os.path.join(scene_dir, "gt_vertex.npz"),
+                                            os.path.join(REPO, "tests", "e2e")])
+    v = out.split() if out is not None else []
+    return tuple(float(x) for x in v) if len(v) == 4 else None
 
 
 def parse_eval(text):
