@@ -24,8 +24,9 @@ struct GlApi;
 std::string reflectance_program_source(const char *body);
 
 // "#version 330 core", shaders/subpixel_grid.glsl (snap_to_subpixel_grid), then `body`: the vertex
-// shader of a renderer whose pixels are compared with another rasteriser's (the relight renderer's,
-// against the web viewer). Throws ProcessingError when the library was built without the shader.
+// shader of every renderer of the model (the relight renderer's and the live view's; the web viewer
+// starts its own with the same file), so that all place vertices alike. Throws ProcessingError when
+// the library was built without the shader.
 std::string vertex_program_source(const char *body);
 
 // Sets reflectance_model.glsl's uniforms of `program` (which must be in use) for the fit's lobe form and
