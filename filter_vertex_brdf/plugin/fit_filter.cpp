@@ -133,9 +133,11 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "Each viewpoint's camera is measured against its photos (the normals photometric "
                            "stereo reads from them, which the light does not change) and, where it is off by "
                            "more than a quarter pixel, corrected (turn and focal length) before any sample is "
-                           "taken. The corrected cameras are applied to the project's rasters and written to "
-                           "<output>_registered.mlp; the input project is never changed. The report gives each "
-                           "viewpoint's misregistration before and after. Off by default."));
+                           "taken, unless the camera as given explains the photos better (the fitted model's "
+                           "residual); a correction's shift is then refined by that residual. The corrected "
+                           "cameras are applied to the project's rasters and written to <output>_registered.mlp; "
+                           "the input project is never changed. The report gives each viewpoint's "
+                           "misregistration before and after. On by default."));
   params.addParam(RichBool(kRefineNormals, vbrdf::FitSettings().shading_normals.enabled, "Refine normals from photos",
                            "A scanned mesh is smoother than the surface, its normals a few degrees off. On: each "
                            "vertex's shading normal is refined from its photos jointly with its reflectance "

@@ -40,6 +40,7 @@ int usage() {
                "                 [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]\n"
                "                 [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]\n"
                "                 [--registration on|off] [--registration-threshold PX]\n"
+               "                 [--registration-residual on|off]\n"
                "                 [--shading-normals on|off] [--normal-prior DEG] [--normal-neighbours DEG] [--normal-rounds N] [--normal-highlights on|off] [--normal-min-gain G]\n";
   return 2;
 }
@@ -81,6 +82,7 @@ int main(int argc, char **argv) {
     else if (a == "--deconvolve") settings.deconvolve_albedo = next() == "on";
     else if (a == "--registration") settings.registration.enabled = next() == "on";
     else if (a == "--registration-threshold") settings.registration.threshold_px = std::stof(next());
+    else if (a == "--registration-residual") settings.registration_residual.enabled = next() == "on";
     else if (a == "--shading-normals") settings.shading_normals.enabled = next() == "on";
     else if (a == "--normal-prior") settings.shading_normals.mesh_normal_degrees = std::stof(next());
     else if (a == "--normal-neighbours") settings.shading_normals.neighbour_degrees = std::stof(next());

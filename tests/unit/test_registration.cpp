@@ -1,10 +1,13 @@
 // Registration refined from the photos (registration/): the light-normalised normal map, the warp
-// applied to a shot, and a synthetic capture whose camera is off by a known amount.
+// applied to a shot, and a synthetic capture whose camera is off by a known amount; the fitted
+// model's residual that checks and refines a correction (fit/residual_alignment.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,10 +18,12 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "fit/residual_alignment.h"
 #include "inputs/light_source.h"
 #include "inputs/project.h"
 #include "io/registered_project.h"
 #include "registration/registration.h"
+#include "visibility/visibility_masks.h"
 #include "test_paths.h"
 #include "test_scenes.h"
 
@@ -327,4 +332,79 @@ TEST(Registration, RegisteredProjectReplacesOnlyTheCorrectedCamerasAndLeavesTheI
     EXPECT_GT(std::fabs(moved.x - project_to_image(a, point).x), 0.5);
   }
   EXPECT_TRUE(same_shot(p.rasters[2].shot, b));
+}
+
+namespace {
+// The residual of the sphere capture's one viewpoint, with masks made at `at` (as the fit makes
+// them at the corrected camera).
+struct SphereResidual {
+  PhotoCache photos{PhotoEncoding::Linear, 0.99f, size_t(1) << 30};
+  MeshView view;
+  std::vector<Raster> rasters;
+  std::vector<LightSource> lights;
+  VisibilityMasks masks;
+  GatherSettings gather;
+  ReflectanceFitOptions fit;
+  std::function<void(SampleChunk &)> prepare;
+  std::unique_ptr<ViewpointResidual> residual;
+  SphereResidual(const SphereCapture &c, const Shot &at) : view(c.mesh.view()) {
+    rasters = rasters_with(c, at);
+    lights = directional_lights(c.lights);
+    auto visibility = make_cpu_visibility(view, VisibilitySettings());
+    masks = compute_visibility(view, rasters, lights, *visibility);
+    std::vector<size_t> all(rasters.size());
+    for (size_t r = 0; r < all.size(); ++r) all[r] = r;
+    const ResidualAlignmentSettings settings;
+    residual = std::make_unique<ViewpointResidual>(view, rasters, all, lights, masks, gather, fit, photos, prepare,
+                                                   settings.pilot_vertices, settings.trimmed_share);
+  }
+};
+} // namespace
+
+// shifted_shot moves the image by the shift asked for (at the principal point; a turn of the camera,
+// so within a few thousandths of a pixel across an object near the centre).
+TEST(ResidualAlignment, ShiftedShotMovesTheImageByTheShift) {
+  const float eye[3] = {1, 2, 5}, target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+  const Shot shot = test::make_look_at_shot(eye, target, up, 800.0f, 640, 480, 320.0f, 240.0f);
+  const Shot moved = shifted_shot(shot, 0.3, -0.2);
+  const float p[3] = {0, 0, 0};
+  const ImagePoint a = project_to_image(shot, p), b = project_to_image(moved, p);
+  EXPECT_NEAR(b.x - a.x, 0.3, 3e-3);
+  EXPECT_NEAR(b.y - a.y, -0.2, 3e-3);
+}
+
+// The residual is least at the true camera: a camera a pixel off (what a false normal-map reading
+// would apply) explains the photos worse, so the fit refuses such a correction.
+TEST(ResidualAlignment, ResidualIsLeastAtTheTrueCamera) {
+  const SphereCapture c = render_sphere(test::scratch_dir("residual_least"));
+  SphereResidual r(c, c.truth);
+  ASSERT_GT(r.residual->pilot_vertices(), 200u);
+  const double at_truth = r.residual->at(c.truth);
+  ASSERT_TRUE(std::isfinite(at_truth));
+  for (const auto &d : std::vector<std::array<float, 2>>{{1.0f, 0.5f}, {-0.2f, 0.0f}, {0.0f, 0.2f}})
+    EXPECT_GT(r.residual->at(shifted(c.truth, d[0], d[1])), at_truth) << d[0] << ", " << d[1] << " px";
+}
+
+// A shift below the normal map's threshold (which leaves it alone) is recovered by the residual:
+// the refined camera ends within a few hundredths of a pixel of the truth.
+TEST(ResidualAlignment, RefinementRecoversASmallShift) {
+  const SphereCapture c = render_sphere(test::scratch_dir("residual_shift"));
+  const Shot given = shifted(c.truth, 0.15f, -0.1f);
+  ASSERT_GT(rms_between(c.mesh, given, c.truth), 0.15);
+  ASSERT_LT(rms_between(c.mesh, given, c.truth), RegistrationSettings().threshold_px);
+  SphereResidual r(c, given);
+  const ResidualShift shift = refine_shift_by_residual(*r.residual, given, ResidualAlignmentSettings());
+  EXPECT_TRUE(shift.moved);
+  EXPECT_LT(shift.residual_end, shift.residual_start);
+  EXPECT_LT(rms_between(c.mesh, shifted_shot(given, shift.dx, shift.dy), c.truth), 0.04)
+      << "refined by " << shift.dx << ", " << shift.dy << " px";
+}
+
+// At the true camera the refinement keeps it, or moves it by no more than a few hundredths.
+TEST(ResidualAlignment, ExactCameraStaysWhereItIs) {
+  const SphereCapture c = render_sphere(test::scratch_dir("residual_exact"));
+  SphereResidual r(c, c.truth);
+  const ResidualShift shift = refine_shift_by_residual(*r.residual, c.truth, ResidualAlignmentSettings());
+  EXPECT_LT(std::hypot(shift.dx, shift.dy), 0.04);
+  EXPECT_LE(shift.residual_end, shift.residual_start);
 }

@@ -262,12 +262,22 @@ std::string describe_registration(const ViewpointRegistration &v, const Registra
   if (v.too_large)
     return s + ", beyond the " + fixed(settings.max_correction_px, 1) +
            " px this refines: camera unchanged (register the photos to the mesh again in MeshLab)";
+  const std::string residuals = "the fitted model's residual over " + std::to_string(v.residual_vertices) +
+                                " vertices: given camera " + three_significant(v.residual_given) + ", corrected " +
+                                three_significant(v.residual_corrected);
+  if (v.refused)
+    return s + ", above " + fixed(settings.threshold_px) + " px, but " + residuals +
+           ": the correction does not explain the photos better, camera unchanged";
   if (!v.applied) return s + ", below " + fixed(settings.threshold_px) + " px: camera unchanged";
   s += " -> " + fixed(v.after_px) + " px after correction (shift " + fixed(v.shift_x) + ", " + fixed(v.shift_y) +
        " px at the principal point";
   s += v.roll_determined ? ", roll " + fixed(degrees(v.correction.roll), 3) + " deg" : ", roll not determined";
   s += v.scale_determined ? ", focal x" + fixed(std::exp(v.correction.log_scale), 4) : ", focal not determined";
-  return s + ")";
+  s += ")";
+  if (v.residual_checked)
+    s += "; " + residuals + ", " + three_significant(v.residual_final) + " with the shift refined by " +
+         fixed(v.refined_x, 3) + ", " + fixed(v.refined_y, 3) + " px";
+  return s;
 }
 
 RegistrationResult refine_registration(const MeshView &mesh, const std::vector<Raster> &rasters,

@@ -25,10 +25,12 @@
 namespace vbrdf {
 
 struct RegistrationSettings {
-  // Off by default: on the synthetic captures of synthesize_scene, whose cameras are exact, the
-  // measurement reads up to 1.3 px (open mesh borders and broad glossy lobes bias the Lambertian
-  // normal map: docs/method.md#registration-refined-from-the-photos), so it is the user's choice.
-  bool enabled = false;
+  // On by default. The measurement alone is not trusted with a correction: on the synthetic
+  // captures of synthesize_scene, whose cameras are exact, it reads up to 1.3 px (open mesh borders
+  // and broad glossy lobes bias the Lambertian normal map: docs/method.md#registration-refined-from-the-photos);
+  // the fit checks each correction against the fitted model's residual and refuses those
+  // (fit/residual_alignment.h, run/fit_run.cpp).
+  bool enabled = true;
   // A viewpoint whose measured misregistration (RMS displacement of its visible vertices, pixels)
   // is below this keeps its camera: the estimate on exact cameras stays under it
   // (docs/benchmark.md#real-captures-cameras-off-and-smoothed-normals).
@@ -65,6 +67,13 @@ struct ViewpointRegistration {
   bool applied = false;
   bool too_large = false;       // above max_correction_px: kept, with a warning
   Shot given, corrected;        // the viewpoint's shot as given and as corrected (equal unless applied)
+  // Checked by the fitted model's residual (fit/residual_alignment.h; mean absolute RGB error of
+  // per-vertex fits with the mesh's normals), when a correction was applied:
+  bool residual_checked = false;
+  size_t residual_vertices = 0;
+  double residual_given = 0, residual_corrected = 0, residual_final = 0;
+  bool refused = false;             // the given camera had the lower residual: camera kept
+  double refined_x = 0, refined_y = 0;  // the shift the residual added to the correction (pixels)
 };
 
 struct RegistrationResult {

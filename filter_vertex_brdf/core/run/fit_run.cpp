@@ -441,9 +441,22 @@ void check_output_paths(FitRun &run) {
   result.output_note = check_output_path(result.output_ply, settings.overwrite, "Output PLY");
 }
 
+// The rasters and lights of the run take the registration's current cameras.
+void take_registered_cameras(FitRun &run) {
+  run.input.rasters = run.result.registration.rasters;
+  run.lights = resolve_lights(run.input.rasters, run.result.light_file, run.placement);
+}
+
+// Whether the registration's corrections wait for the residual check (check_corrections_by_residual)
+// before the run takes them: then the depth passes run at the given cameras, so that a refused
+// correction costs no second pass.
+bool corrections_checked_by_residual(const FitSettings &settings) {
+  return settings.registration.enabled && settings.registration_residual.enabled && settings.fit_reflectance;
+}
+
 // Each viewpoint's camera measured against its photos and corrected above the threshold
 // (registration.h): the rest of the run uses the corrected cameras, and an .lp's directions,
-// given in the camera frame, follow them.
+// given in the camera frame, follow them; after the residual check where it runs.
 void refine_cameras(FitRun &run, PhotoCache &photos) {
   if (!run.settings.registration.enabled) return;
   if (run.progress && !run.progress(0.0f, "registration")) throw ProcessingError("cancelled");
@@ -452,11 +465,81 @@ void refine_cameras(FitRun &run, PhotoCache &photos) {
   result.registration = refine_registration(run.input.mesh, run.input.rasters, run.lights, photos, run.visibility,
                                             run.settings.registration, run.log);
   if (result.registration.any_applied()) {
-    run.input.rasters = result.registration.rasters;
     result.registered_project = registered_project_path(result.output_ply);
-    run.lights = resolve_lights(run.input.rasters, result.light_file, run.placement);
+    if (!corrections_checked_by_residual(run.settings)) take_registered_cameras(run);  // else after the check
   }
   result.seconds_registration = seconds_since(started);
+}
+
+// The residual of viewpoint v's photos (fit/residual_alignment.h) at any camera, with `masks`.
+ViewpointResidual viewpoint_residual(FitRun &run, const ViewpointRegistration &v, PhotoCache &photos,
+                                     const VisibilityMasks &masks, const std::function<void(SampleChunk &)> &prepare) {
+  const ResidualAlignmentSettings &check = run.settings.registration_residual;
+  return ViewpointResidual(run.input.mesh, run.input.rasters, v.rasters, run.lights, masks, run.settings.gather,
+                           run.settings.reflectance, photos, prepare, check.pilot_vertices, check.trimmed_share);
+}
+
+// Each viewpoint the registration corrected, checked by the fitted model's residual
+// (fit/residual_alignment.h) with the masks made at the given cameras: refused (camera kept) where
+// the given camera explains the photos as well. Returns true when a correction was taken: the run
+// then uses the corrected cameras and needs masks made at them.
+bool check_corrections_by_residual(FitRun &run, PhotoCache &photos, const VisibilityMasks &masks,
+                                   const std::function<void(SampleChunk &)> &prepare) {
+  RegistrationResult &registration = run.result.registration;
+  if (!corrections_checked_by_residual(run.settings) || !registration.any_applied()) return false;
+  if (run.progress && !run.progress(0.4f, "registration check")) throw ProcessingError("cancelled");
+  const auto started = Clock::now();
+  for (ViewpointRegistration &v : registration.viewpoints) {
+    if (!v.applied) continue;
+    ViewpointResidual residual = viewpoint_residual(run, v, photos, masks, prepare);
+    if (residual.pilot_vertices() < run.settings.registration.min_vertices) continue;  // taken unchecked
+    v.residual_checked = true;
+    v.residual_vertices = residual.pilot_vertices();
+    v.residual_given = residual.at(v.given);
+    v.residual_corrected = v.residual_final = residual.at(v.corrected);
+    if (!(v.residual_corrected < v.residual_given)) {
+      v.refused = true, v.applied = false;
+      v.corrected = v.given;
+      for (size_t r : v.rasters) registration.rasters[r].shot = v.given;
+      run.log("Registration: " + describe_registration(v, run.settings.registration) + ".");
+    }
+  }
+  run.result.seconds_registration += seconds_since(started);
+  if (!registration.any_applied()) {
+    run.result.registered_project.clear();
+    return false;
+  }
+  take_registered_cameras(run);
+  return true;
+}
+
+// Each correction the residual confirmed, its shift refined to the residual's minimum with masks
+// made at the corrected camera. Returns true when a camera moved: the masks must be made again,
+// because the camera pass's rim footprints follow the camera to a fraction of a pixel (masks made
+// 0.06 px from the camera cost bunny 6 % of its relit error).
+bool refine_corrections_by_residual(FitRun &run, PhotoCache &photos, const VisibilityMasks &masks,
+                                    const std::function<void(SampleChunk &)> &prepare) {
+  RegistrationResult &registration = run.result.registration;
+  const auto started = Clock::now();
+  bool moved = false;
+  for (ViewpointRegistration &v : registration.viewpoints) {
+    if (!v.applied || !v.residual_checked) continue;
+    ViewpointResidual residual = viewpoint_residual(run, v, photos, masks, prepare);
+    const ResidualShift shift = refine_shift_by_residual(residual, v.corrected, run.settings.registration_residual);
+    v.residual_corrected = shift.residual_start;
+    v.residual_final = shift.residual_end;
+    if (shift.moved) {
+      v.corrected = shifted_shot(v.corrected, shift.dx, shift.dy);
+      v.refined_x = shift.dx, v.refined_y = shift.dy;
+      v.shift_x += shift.dx, v.shift_y += shift.dy;
+      for (size_t r : v.rasters) registration.rasters[r].shot = v.corrected;
+      moved = true;
+    }
+    run.log("Registration: " + describe_registration(v, run.settings.registration) + ".");
+  }
+  if (moved) take_registered_cameras(run);
+  run.result.seconds_registration += seconds_since(started);
+  return moved;
 }
 
 // The depth passes (visibility masks restricted to the selection), with every viewpoint's colour
@@ -661,19 +744,26 @@ FitResult run_fit(const FitInput &given, const FitSettings &settings, Visibility
   const std::unique_ptr<PhotoPrefetch> prefetch = start_photo_prefetch(photos, run.input.rasters);
   refine_cameras(run, photos);
   ColorPlan colors;
-  const VisibilityMasks masks = visibility_and_colors(run, photos, colors);
+  VisibilityMasks masks = visibility_and_colors(run, photos, colors);
   prefetch->finish();
   auto t = Clock::now();
   check_photos(run, photos);
-  check_cameras_see_mesh(run, masks);
   result.seconds_photo_checks = seconds_since(t);
+  // The same colour correction and light fall-off as the fit, for the stages that fit a subset.
+  const std::function<void(SampleChunk &)> prepare = [&](SampleChunk &chunk) {
+    if (colors.any_corrected()) correct_samples(colors, chunk);
+    apply_light_falloff(chunk, run.input.mesh, run.lights);
+  };
+  // The registration's corrections, checked and refined by the fitted model's residual: the masks
+  // follow the cameras (a refused correction costs no second pass).
+  if (check_corrections_by_residual(run, photos, masks, prepare)) {
+    masks = visibility_and_colors(run, photos, colors);
+    if (refine_corrections_by_residual(run, photos, masks, prepare)) masks = visibility_and_colors(run, photos, colors);
+  }
+  check_cameras_see_mesh(run, masks);
 
   t = Clock::now();
-  const bool correct = colors.any_corrected();
-  decide_diffuse_form(run.input, run.lights, masks, photos, [&](SampleChunk &chunk) {
-    if (correct) correct_samples(colors, chunk);
-    apply_light_falloff(chunk, run.input.mesh, run.lights);
-  }, log, run.settings, result);
+  decide_diffuse_form(run.input, run.lights, masks, photos, prepare, log, run.settings, result);
   result.seconds_pilot = seconds_since(t);
 
   const bool with_materials = run.settings.fit_reflectance && run.settings.materials;

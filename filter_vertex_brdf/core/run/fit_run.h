@@ -18,6 +18,7 @@
 #include "fit/reflectance_fit.h"
 #include "fit/materials.h"
 #include "fit/photo_shadows.h"
+#include "fit/residual_alignment.h"
 #include "fit/shading_normals.h"
 #include "base/mesh_view.h"
 #include "base/output_file.h"
@@ -79,6 +80,10 @@ struct FitSettings {
   // the threshold (registration/registration.h); the corrected cameras go into
   // <ply stem>_registered.mlp beside the result. Off: the cameras as given.
   RegistrationSettings registration;
+  // A viewpoint whose camera the registration corrected is checked and refined by the fitted
+  // model's residual (fit/residual_alignment.h): the correction is refused where the given camera
+  // explains the photos better, else its shift is refined to where the residual is least.
+  ResidualAlignmentSettings registration_residual;
   // Each vertex's shading normal refined from its samples, jointly with its reflectance
   // (fit/shading_normals.h): fit with the mesh's normals, refine, shade the samples again, fit
   // again. Visibility and shadows keep the mesh. The PLY's nx ny nz are the refined normals

@@ -1,0 +1,102 @@
+#pragma once
+// A viewpoint's camera checked and refined by the fitted model's residual, after registration.h
+// has measured and corrected it from the photos' Lambertian normal map.
+//
+// Why: the normal map is biased by what a Lambertian per-pixel fit cannot explain (broad lobes,
+// open mesh borders, shadows), by 0.02-0.07 px on the shared scenes and by up to 1.3 px on
+// synthetic ones, and a fit is sensitive at that scale (a tenth of a pixel costs bunny 10 % of its
+// relit error). When the photos are shifted against the mesh, each vertex's samples come from a
+// neighbouring surface point whose shading its mesh normal does not predict; no per-vertex model
+// explains that, so the residual of per-vertex fits made with the mesh's normals is least at the
+// true camera (within 0.015 px on the shared scenes: docs/decisions/registration.md).
+//
+// Contract:
+// - Pilot vertices: every k-th vertex seen by at least 4 of the viewpoint's photos and on no
+//   silhouette or contact in any of them (mixed pixels move with the camera in a way the masks,
+//   made from one camera, do not follow), k chosen for about `pilot_vertices`.
+// - Residual at a shot: the viewpoint's photos, taking that shot, are sampled at the pilot
+//   vertices (the caller's masks, PhotoCache and `prepare`: colour correction and light fall-off
+//   as the fit applies them); each vertex is fitted by the CPU reference (fit_vertex_cpu, the
+//   mesh's normals) and its usable samples (lit, unsaturated, clean, d > 0) scored by their mean
+//   absolute RGB error. The residual is the trimmed mean over all of them: the `trimmed_share`
+//   the models explain best. The samples no per-vertex model explains (interreflections, shadow
+//   edges, the tails of broad lobes) do not move with the camera as the others do and pull the
+//   minimum off the true camera (spot: 0.06 px with every sample, 0.02 px with the best half).
+//   Non-finite samples are skipped; with no scored sample it is +infinity.
+// - Refinement: a quadratic in (dx, dy) fitted to the residual on a 3x3 grid of image shifts of
+//   `step_px`; its minimum when the quadratic is convex and the minimum lies within 1.5 steps of the
+//   grid's centre, else the best grid point and a new grid about it; at most `max_rounds` grids,
+//   and the shift never beyond `max_shift_px` from the start. The refined shift is kept only when its
+//   residual is below the start's; else the start is kept.
+// - The masks may come from a camera a few pixels away (the fit makes them at the given camera and
+//   checks the correction against it): the pilot leaves out the rims, where that would matter.
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "base/mesh_view.h"
+#include "fit/reflectance_fit.h"
+#include "inputs/camera.h"
+#include "inputs/light_source.h"
+#include "inputs/photo.h"
+#include "samples/samples.h"
+#include "visibility/visibility_masks.h"
+
+namespace vbrdf {
+
+struct ResidualAlignmentSettings {
+  bool enabled = true;
+  size_t pilot_vertices = 4000;  // per viewpoint (docs/decisions/registration.md: fewer read noisier)
+  double step_px = 0.1;          // grid spacing: the residual is a clean quadratic over +-0.2 px
+  double max_shift_px = 0.3;     // the refinement's reach from the start camera
+  int max_rounds = 3;
+  double trimmed_share = 0.5;    // of the scored samples, the best explained (docs/decisions/registration.md)
+};
+
+// The residual of one viewpoint's photos at any shot of its camera (see the contract above).
+class ViewpointResidual {
+public:
+  ViewpointResidual(const MeshView &mesh, const std::vector<Raster> &rasters, const std::vector<size_t> &viewpoint,
+                    const std::vector<LightSource> &lights, const VisibilityMasks &masks, const GatherSettings &gather,
+                    const ReflectanceFitOptions &fit, PhotoCache &photos,
+                    const std::function<void(SampleChunk &)> &prepare, size_t pilot_vertices,
+                    double trimmed_share);
+  size_t pilot_vertices() const { return pilot_count_; }
+  size_t evaluations() const { return evaluations_; }
+  double at(const Shot &shot);
+
+private:
+  const MeshView &mesh_;
+  std::vector<Raster> rasters_;  // every raster; the viewpoint's take the shot being scored
+  std::vector<size_t> viewpoint_;
+  const std::vector<LightSource> &lights_;
+  size_t pilot_count_ = 0;       // before pilot_, whose initialisation sets it
+  VisibilityMasks pilot_;        // the viewpoint's photos and the pilot vertices only
+  GatherSettings gather_;
+  const ReflectanceFitOptions &fit_;
+  PhotoCache &photos_;
+  const std::function<void(SampleChunk &)> &prepare_;
+  double trimmed_share_;
+  size_t evaluations_ = 0;
+};
+
+struct ResidualShift {
+  double dx = 0, dy = 0;                 // image shift from the start camera (pixels)
+  double residual_start = 0, residual_end = 0;
+  int rounds = 0;
+  bool moved = false;                    // false: the start camera had the lower residual
+};
+
+// Minimises the residual over image shifts of `start` (see the contract above).
+// `start_residual`: residual.at(start) when the caller has it (NaN: computed here).
+ResidualShift refine_shift_by_residual(ViewpointResidual &residual, const Shot &start,
+                                       const ResidualAlignmentSettings &settings,
+                                       double start_residual = std::numeric_limits<double>::quiet_NaN());
+
+// `shot` turned about its centre so that its image moves by (dx, dy) pixels at the principal point
+// (x right, y down): pitch and yaw, as registration.h applies a shift.
+Shot shifted_shot(const Shot &shot, double dx, double dy);
+
+} // namespace vbrdf
