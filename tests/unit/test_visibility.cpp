@@ -16,6 +16,7 @@
 #include "gl/gl_api.h"
 #include "base/mesh_view.h"
 #include "osmesa_context.h"
+#include "visibility/camera_pass_cache.h"
 #include "visibility/pass_size.h"
 #include "visibility/visibility.h"
 #include "visibility/visibility_gl.h"
@@ -1328,4 +1329,49 @@ TEST_F(GlVisibilityTest, LightPassesTestOnlyTheWantedVertices) {
 }
 
 } // namespace
+} // namespace vbrdf
+
+// ---------------------------------------------------------------------------------------------
+// Camera pass cache (camera_pass_cache.h).
+
+namespace vbrdf {
+namespace {
+struct CountingBackend : VisibilityBackend {
+  VisibilityBackend &inner;
+  int camera_passes = 0;
+  explicit CountingBackend(VisibilityBackend &b) : inner(b) {}
+  const char *name() const override { return "counting"; }
+  void camera_pass(const Shot &shot, uint8_t *out) override {
+    ++camera_passes;
+    inner.camera_pass(shot, out);
+  }
+  void light_pass(const LightSource &light, uint8_t *out, const uint64_t *only) override {
+    inner.light_pass(light, out, only);
+  }
+};
+} // namespace
+
+// The same camera twice: one pass, the same codes; another camera: a pass of its own.
+TEST(CameraPassCache, ReusesTheLastPassForTheSameCameraOnly) {
+  const MeshData m = box_scene();
+  auto cpu = make_cpu_visibility(m.view(), VisibilitySettings());
+  CountingBackend counting(*cpu);
+  CameraPassCache cache(counting, vertex_count(m));
+  const float eye[3] = {2, -3, 4};
+  const Shot shot = look_at({eye[0], eye[1], eye[2]}, {0, 0, 0}, {0, 0, 1}, 500, 320, 240);
+  std::vector<uint8_t> first(vertex_count(m)), again(vertex_count(m)), direct(vertex_count(m));
+  cache.camera_pass(shot, first.data());
+  cache.camera_pass(shot, again.data());
+  EXPECT_EQ(counting.camera_passes, 1);
+  EXPECT_EQ(cache.reused(), 1u);
+  EXPECT_EQ(first, again);
+  cpu->camera_pass(shot, direct.data());
+  EXPECT_EQ(first, direct);
+  EXPECT_GT(std::count(first.begin(), first.end(), kCameraHidden), 0);  // the box hides part of the ground
+  const float other_eye[3] = {-2, -3, 4};
+  cache.camera_pass(look_at({other_eye[0], other_eye[1], other_eye[2]}, {0, 0, 0}, {0, 0, 1}, 500, 320, 240), again.data());
+  EXPECT_EQ(counting.camera_passes, 2);
+  EXPECT_NE(first, again);
+}
+
 } // namespace vbrdf

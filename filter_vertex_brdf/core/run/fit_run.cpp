@@ -28,6 +28,7 @@
 #include "samples/light_check.h"
 #include "samples/reshade.h"
 #include "samples/sample_colors.h"
+#include "visibility/camera_pass_cache.h"
 #include "visibility/pass_size.h"
 #include "visibility/visibility_masks.h"
 
@@ -542,17 +543,15 @@ bool refine_corrections_by_residual(FitRun &run, PhotoCache &photos, const Visib
   return moved;
 }
 
-// The depth passes (visibility masks restricted to the selection), with every viewpoint's colour
-// plan searched beside them (ColorPlanBesidePasses); a required chart that is missing stops the
-// passes.
-VisibilityMasks visibility_and_colors(FitRun &run, PhotoCache &photos, ColorPlan &colors) {
+// The depth passes at the run's cameras (visibility masks restricted to the selection), timed and
+// described for the report. `between_passes` runs at each progress step (the colour search's
+// failure surfaces there).
+VisibilityMasks depth_passes(FitRun &run, const std::function<void()> &between_passes = {}) {
   const FitInput &input = run.input;
   FitResult &result = run.result;
-  if (run.progress) run.progress(0.0f, "colour calibration");
-  ColorPlanBesidePasses color_search(input, run.settings, light_directions(run.lights), photos);
   const auto started = Clock::now();
   const ProgressFn vis_progress = [&](float f, const char *s) {
-    color_search.rethrow_if_failed();
+    if (between_passes) between_passes();
     return !run.progress || run.progress(0.4f * f, s);
   };
   VisibilityMasks masks = compute_visibility(input.mesh, input.rasters, run.lights, run.visibility, vis_progress);
@@ -561,7 +560,18 @@ VisibilityMasks visibility_and_colors(FitRun &run, PhotoCache &photos, ColorPlan
                         std::to_string(input.rasters.size()) + " photos (photos of one camera share its pass)" +
                         (sizes.empty() ? std::string() : "; " + sizes);
   restrict_to_vertices(masks, input.vertex_mask);
-  result.seconds_visibility = seconds_since(started);
+  result.seconds_visibility += seconds_since(started);
+  return masks;
+}
+
+// The depth passes (visibility masks restricted to the selection), with every viewpoint's colour
+// plan searched beside them (ColorPlanBesidePasses); a required chart that is missing stops the
+// passes.
+VisibilityMasks visibility_and_colors(FitRun &run, PhotoCache &photos, ColorPlan &colors) {
+  FitResult &result = run.result;
+  if (run.progress) run.progress(0.0f, "colour calibration");
+  ColorPlanBesidePasses color_search(run.input, run.settings, light_directions(run.lights), photos);
+  VisibilityMasks masks = depth_passes(run, [&] { color_search.rethrow_if_failed(); });
   colors = color_search.take(run.log, result.seconds_colors);
   result.color_viewpoints_corrected = size_t(std::count_if(
       colors.viewpoints.begin(), colors.viewpoints.end(), [](const ColorCalibration &c) { return c.corrected; }));
@@ -728,7 +738,9 @@ void write_outputs(FitRun &run, const FitInput &given) {
 FitResult run_fit(const FitInput &given, const FitSettings &settings, VisibilityBackend &visibility,
                   ReflectanceFitter *fitter, const ProgressFn &progress, const LogFn &log) {
   validate_input(given);
-  FitRun run{given, settings_for_run(settings, given.mesh, fitter), visibility, fitter, progress, log, {}, {}, {}};
+  // The registration's camera pass at a given camera is the depth passes' first (camera_pass_cache.h).
+  CameraPassCache passes(visibility, given.mesh.vertex_count);
+  FitRun run{given, settings_for_run(settings, given.mesh, fitter), passes, fitter, progress, log, {}, {}, {}};
   FitResult &result = run.result;
   result.visibility_backend = visibility.name();
   result.fit_backend = run.settings.fit_reflectance ? fitter->name() : "";
@@ -757,8 +769,8 @@ FitResult run_fit(const FitInput &given, const FitSettings &settings, Visibility
   // The registration's corrections, checked and refined by the fitted model's residual: the masks
   // follow the cameras (a refused correction costs no second pass).
   if (check_corrections_by_residual(run, photos, masks, prepare)) {
-    masks = visibility_and_colors(run, photos, colors);
-    if (refine_corrections_by_residual(run, photos, masks, prepare)) masks = visibility_and_colors(run, photos, colors);
+    masks = depth_passes(run);
+    if (refine_corrections_by_residual(run, photos, masks, prepare)) masks = depth_passes(run);
   }
   check_cameras_see_mesh(run, masks);
 
