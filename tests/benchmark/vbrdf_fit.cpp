@@ -6,7 +6,7 @@
 //             [--photo-shadows on|off]
 //             [--lobe re|nh|ggx] [--diffuse auto|lambert|coated] [--photo-memory-mb N] [--resolution-weights on|off]
 //             [--footprint on|off] [--deconvolve on|off] [--deconvolve-lambda 0.02] [--deconvolve-edge 0.5] [--deconvolve-misfit 0.01]
-//             [--registration on|off] [--registration-threshold 0.25]
+//             [--registration on|off] [--registration-threshold 0.25] [--registration-residual on|off]
 //             [--shading-normals on|off] [--normal-prior DEG] [--normal-neighbours DEG] [--normal-rounds N] [--normal-highlights on|off] [--normal-min-gain G]
 //             [--no-remedies]   (thesis behaviour: no highlight weight cap, no prior, k_s free with
 //                                one highlight sample; to show the diffuse holes it causes)
