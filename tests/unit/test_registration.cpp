@@ -44,11 +44,14 @@ struct SphereCapture {
 
 double albedo_at(const double p[3]) { return std::fmod(std::floor((p[1] + 1.0) * 4.0), 2.0) < 1 ? 0.3 : 0.75; }
 
-SphereCapture render_sphere(const std::string &folder, size_t light_count = 8) {
+// `off_axis`: the camera looks that far (world units, along x and y) beside the sphere's centre, so
+// that the sphere is seen away from the optical axis (a roll about it then moves the sphere's image).
+SphereCapture render_sphere(const std::string &folder, size_t light_count = 8, float off_axis = 0) {
   SphereCapture c;
   const float centre[3] = {0, 0, 0}, eye[3] = {0.4f, 0.5f, 4.0f}, up[3] = {0, 1, 0};
+  const float target[3] = {off_axis, 0.6f * off_axis, 0};
   c.mesh = test::make_sphere(centre, 1.0f, 90, 180);
-  c.truth = test::make_look_at_shot(eye, centre, up, 400.0f, 320, 240);
+  c.truth = test::make_look_at_shot(eye, target, up, 400.0f, 320, 240);
   for (size_t k = 0; k < light_count; ++k) {
     const double th = (k % 2 ? 55.0 : 30.0) * kPi / 180, ph = 2 * kPi * double(k) / double(light_count);
     // Around the camera's direction (+z side of the sphere).
@@ -407,4 +410,18 @@ TEST(ResidualAlignment, ExactCameraStaysWhereItIs) {
   const ResidualShift shift = refine_shift_by_residual(*r.residual, c.truth, ResidualAlignmentSettings());
   EXPECT_LT(std::hypot(shift.dx, shift.dy), 0.04);
   EXPECT_LE(shift.residual_end, shift.residual_start);
+}
+
+// A roll about the optical axis of a few hundredths of a degree (what the normal map leaves), the
+// object away from the axis: the residual refines it to within 40 % of itself.
+TEST(ResidualAlignment, RollIsRefinedTowardsTheTrueCamera) {
+  const SphereCapture c = render_sphere(test::scratch_dir("residual_roll"), 8, 0.25f);
+  const double applied = 0.06 * kPi / 180;  // what the normal map leaves is a few hundredths
+  const Shot given = rolled_shot(c.truth, applied);
+  SphereResidual r(c, given);
+  const ResidualRoll roll = refine_roll_by_residual(*r.residual, given, ResidualAlignmentSettings());
+  EXPECT_TRUE(roll.moved);
+  EXPECT_LT(roll.residual_end, roll.residual_start);
+  EXPECT_LT(std::fabs(applied + roll.roll), 0.4 * applied) << "refined by " << roll.roll * 180 / kPi << " deg";
+  EXPECT_LT(rms_between(c.mesh, rolled_shot(given, roll.roll), c.truth), rms_between(c.mesh, given, c.truth));
 }

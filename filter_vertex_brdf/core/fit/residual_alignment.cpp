@@ -71,6 +71,12 @@ bool quadratic_minimum(const std::vector<double> &xs, const std::vector<double> 
 
 } // namespace
 
+Shot rolled_shot(const Shot &shot, double roll) {
+  ImageWarp w;
+  w.roll = roll;
+  return warped_shot(shot, w);
+}
+
 Shot shifted_shot(const Shot &shot, double dx, double dy) {
   // warp_point moves the principal point by (f tan(yaw), -f tan(pitch)) (image_alignment.h).
   const double f = focal_pixels(shot);
@@ -165,6 +171,49 @@ ResidualShift refine_shift_by_residual(ViewpointResidual &residual, const Shot &
   if (best < out.residual_start) {
     out.dx = best_x, out.dy = best_y, out.residual_end = best, out.moved = true;
   }
+  return out;
+}
+
+} // namespace vbrdf
+
+namespace vbrdf {
+
+double ViewpointResidual::rms_radius(const Shot &shot) const {
+  double c[2];
+  principal_point(shot, c);
+  double sum = 0;
+  size_t n = 0;
+  for (size_t v = 0; v < pilot_.vertex_count; ++v) {
+    if (!pilot_.is_seen(viewpoint_.front(), v)) continue;
+    const ImagePoint p = project_to_image(shot, mesh_.positions + 3 * v);
+    if (!p.in_front) continue;
+    sum += (p.x - c[0]) * (p.x - c[0]) + (p.y - c[1]) * (p.y - c[1]);
+    ++n;
+  }
+  return n ? std::sqrt(sum / double(n)) : 0.0;
+}
+
+ResidualRoll refine_roll_by_residual(ViewpointResidual &residual, const Shot &start,
+                                     const ResidualAlignmentSettings &settings, double start_residual) {
+  ResidualRoll out;
+  out.residual_start = out.residual_end = std::isnan(start_residual) ? residual.at(start) : start_residual;
+  const double radius = residual.rms_radius(start);
+  if (!(radius > 1.0) || !std::isfinite(out.residual_start)) return out;  // a point-like view: no roll to read
+  const double delta = settings.step_px / radius;
+  const double e0 = out.residual_start, ep = residual.at(rolled_shot(start, delta)),
+               em = residual.at(rolled_shot(start, -delta));
+  double best = e0, best_roll = 0;
+  if (ep < best) best = ep, best_roll = delta;
+  if (em < best) best = em, best_roll = -delta;
+  const double curvature = em - 2 * e0 + ep;
+  if (curvature > 0 && std::isfinite(curvature)) {
+    const double t = delta * (em - ep) / (2 * curvature);
+    if (std::fabs(t) <= 2 * delta && t != 0) {
+      const double e = residual.at(rolled_shot(start, t));
+      if (e < best) best = e, best_roll = t;
+    }
+  }
+  if (best < out.residual_start) out.roll = best_roll, out.residual_end = best, out.moved = true;
   return out;
 }
 

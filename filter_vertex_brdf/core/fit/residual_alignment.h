@@ -4,7 +4,7 @@
 //
 // Why: the normal map is biased by what a Lambertian per-pixel fit cannot explain (broad lobes,
 // open mesh borders, shadows), by 0.02-0.07 px on the shared scenes and by up to 1.3 px on
-// synthetic ones, and a fit is sensitive at that scale (a tenth of a pixel costs bunny 10 % of its
+// synthetic ones, and a fit is sensitive at that scale (0.07 px costs spot and bunny 15 % of their
 // relit error). When the photos are shifted against the mesh, each vertex's samples come from a
 // neighbouring surface point whose shading its mesh normal does not predict; no per-vertex model
 // explains that, so the residual of per-vertex fits made with the mesh's normals is least at the
@@ -27,7 +27,8 @@
 //   `step_px`; its minimum when the quadratic is convex and the minimum lies within 1.5 steps of the
 //   grid's centre, else the best grid point and a new grid about it; at most `max_rounds` grids,
 //   and the shift never beyond `max_shift_px` from the start. The refined shift is kept only when its
-//   residual is below the start's; else the start is kept.
+//   residual is below the start's; else the start is kept. Then the roll about the optical axis
+//   (refine_roll_by_residual), which the normal map reads to within a few hundredths of a degree.
 // - The masks may come from a camera a few pixels away (the fit makes them at the given camera and
 //   checks the correction against it): the pilot leaves out the rims, where that would matter.
 #include <cstddef>
@@ -66,6 +67,8 @@ public:
   size_t pilot_vertices() const { return pilot_count_; }
   size_t evaluations() const { return evaluations_; }
   double at(const Shot &shot);
+  // RMS distance (pixels) of the pilot vertices' projections from the principal point of `shot`.
+  double rms_radius(const Shot &shot) const;
 
 private:
   const MeshView &mesh_;
@@ -94,6 +97,23 @@ struct ResidualShift {
 ResidualShift refine_shift_by_residual(ViewpointResidual &residual, const Shot &start,
                                        const ResidualAlignmentSettings &settings,
                                        double start_residual = std::numeric_limits<double>::quiet_NaN());
+
+struct ResidualRoll {
+  double roll = 0;                       // radians about the optical axis (ImageWarp::roll), from the start camera
+  double residual_start = 0, residual_end = 0;
+  bool moved = false;
+};
+
+// Refines the roll about the optical axis after the shift: a parabola through the residual at the
+// start and at rolls of +-delta, delta moving the pilot vertices by `step_px` (RMS) about the
+// principal point; its minimum when convex and within 2 delta, kept only when its residual is
+// lower. `start_residual`: residual.at(start) when the caller has it (NaN: computed here).
+ResidualRoll refine_roll_by_residual(ViewpointResidual &residual, const Shot &start,
+                                     const ResidualAlignmentSettings &settings,
+                                     double start_residual = std::numeric_limits<double>::quiet_NaN());
+
+// `shot` turned about its optical axis by `roll` radians (ImageWarp::roll).
+Shot rolled_shot(const Shot &shot, double roll);
 
 // `shot` turned about its centre so that its image moves by (dx, dy) pixels at the principal point
 // (x right, y down): pitch and yaw, as registration.h applies a shift.

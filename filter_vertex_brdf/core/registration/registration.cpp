@@ -276,7 +276,8 @@ std::string describe_registration(const ViewpointRegistration &v, const Registra
   s += ")";
   if (v.residual_checked)
     s += "; " + residuals + ", " + three_significant(v.residual_final) + " with the shift refined by " +
-         fixed(v.refined_x, 3) + ", " + fixed(v.refined_y, 3) + " px";
+         fixed(v.refined_x, 3) + ", " + fixed(v.refined_y, 3) + " px and the roll by " +
+         fixed(degrees(v.refined_roll), 3) + " deg";
   return s;
 }
 

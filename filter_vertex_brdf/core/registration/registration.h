@@ -74,6 +74,7 @@ struct ViewpointRegistration {
   double residual_given = 0, residual_corrected = 0, residual_final = 0;
   bool refused = false;             // the given camera had the lower residual: camera kept
   double refined_x = 0, refined_y = 0;  // the shift the residual added to the correction (pixels)
+  double refined_roll = 0;              // and the roll (radians)
 };
 
 struct RegistrationResult {
