@@ -137,7 +137,7 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "residual); a correction's shift and roll are then refined by that residual. The corrected "
                            "cameras are applied to the project's rasters and written to <output>_registered.mlp; "
                            "the input project is never changed. The report gives each viewpoint's "
-                           "misregistration before and after. On by default."));
+                           "misregistration before and after. Off by default."));
   params.addParam(RichBool(kRefineNormals, vbrdf::FitSettings().shading_normals.enabled, "Refine normals from photos",
                            "A scanned mesh is smoother than the surface, its normals a few degrees off. On: each "
                            "vertex's shading normal is refined from its photos jointly with its reflectance "

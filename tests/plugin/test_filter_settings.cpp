@@ -110,7 +110,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   p.setValue("diffuseTerm", EnumValue(1));
   p.setValue("findMaterials", BoolValue(true));
   p.setValue("sharpenAlbedoEdges", BoolValue(false));
-  p.setValue("refineRegistration", BoolValue(false));
+  p.setValue("refineRegistration", BoolValue(true));
   p.setValue("refineNormals", BoolValue(false));
   p.setValue("maxIterations", IntValue(7));
   p.setValue("minSpecularSamples", IntValue(3));
@@ -124,7 +124,7 @@ TEST(FitSettingsFrom, EveryParameterReachesItsField) {
   EXPECT_FLOAT_EQ(s.dome_radius, 2.5f);
   EXPECT_FLOAT_EQ(s.light_unit_scale, 10.0f);
   EXPECT_EQ(s.output_ply, "out.ply");
-  EXPECT_FALSE(s.registration.enabled);
+  EXPECT_TRUE(s.registration.enabled);
   EXPECT_FALSE(s.shading_normals.enabled);
   EXPECT_EQ(s.overwrite, vbrdf::OverwritePolicy::Refuse);
   EXPECT_FLOAT_EQ(s.gather.specular_threshold, 0.8f);
