@@ -27,11 +27,6 @@ std::string folds_note(size_t photos) {
   return folds > 1 ? ", " + std::to_string(folds) + " folds in turn" : std::string();
 }
 
-bool scorable(const Sample &s) {
-  return !(s.flags & (kShadowed | kSaturated | kMixedPixel | kNotSeen)) && s.d > 0 && std::isfinite(s.d) &&
-         std::isfinite(s.lobe_cos) && std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]);
-}
-
 // Every k-th vertex seen by at least kMinPhotosSeen photos (k for about `target` of them).
 std::vector<uint8_t> pilot_mask(const VisibilityMasks &masks, size_t target, size_t &count) {
   std::vector<uint32_t> seen(masks.vertex_count, 0);
@@ -89,7 +84,7 @@ std::vector<PilotVertex> score_form(const MeshView &mesh, const std::vector<Rast
           if (!has_model(fit)) continue;
           modelled[size_t(n)] = 1;
           for (const Sample *s = begin; s != end; ++s) {
-            if (!held_out_in_fold(s->raster, k) || !scorable(*s)) continue;
+            if (!held_out_in_fold(s->raster, k) || !is_scorable_sample(*s)) continue;
             float predicted[3];
             evaluate_reflectance(fit, s->d, s->lobe_cos, phong.lobe, predicted, s->footprint);
             for (int c = 0; c < 3; ++c) p.error += std::fabs(double(predicted[c]) - double(s->rgb[c])) / 3.0;

@@ -15,11 +15,6 @@ constexpr size_t kMinPhotosSeen = 4;
 
 double bounded(double v, double lo, double hi) { return std::min(std::max(v, lo), hi); }  // C++14: no std::clamp
 
-bool scorable(const Sample &s) {
-  return !(s.flags & (kShadowed | kSaturated | kMixedPixel | kNotSeen)) && s.d > 0 && std::isfinite(s.d) &&
-         std::isfinite(s.lobe_cos) && std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]);
-}
-
 // The masks kept for the viewpoint's rasters and the pilot vertices only (see the contract).
 VisibilityMasks pilot_masks(const VisibilityMasks &masks, const std::vector<size_t> &viewpoint, size_t target,
                             size_t &count) {
@@ -99,7 +94,6 @@ ViewpointResidual::ViewpointResidual(const MeshView &mesh, const std::vector<Ras
 }
 
 double ViewpointResidual::at(const Shot &shot) {
-  ++evaluations_;
   for (size_t r : viewpoint_) rasters_[r].shot = shot;
   std::vector<float> errors;
   gather_samples(mesh_, rasters_, lights_, pilot_, gather_, photos_, [&](SampleChunk &chunk) {
@@ -114,7 +108,7 @@ double ViewpointResidual::at(const Shot &shot) {
       fit_vertex_cpu(begin, size_t(end - begin), fit_, fit);
       if (!has_model(fit)) continue;
       for (const Sample *s = begin; s != end; ++s) {
-        if (!scorable(*s)) continue;
+        if (!is_scorable_sample(*s)) continue;
         float predicted[3];
         evaluate_reflectance(fit, s->d, s->lobe_cos, fit_.lobe, predicted, s->footprint);
         double e = 0;
@@ -141,7 +135,6 @@ ResidualShift refine_shift_by_residual(ViewpointResidual &residual, const Shot &
   out.residual_start = out.residual_end = centre_residual;
   double best_x = 0, best_y = 0, best = centre_residual;
   for (int round = 0; round < settings.max_rounds; ++round) {
-    ++out.rounds;
     std::vector<double> xs, ys, es;
     double grid_best = centre_residual, grid_x = cx, grid_y = cy;
     for (int j = -1; j <= 1; ++j)
@@ -173,10 +166,6 @@ ResidualShift refine_shift_by_residual(ViewpointResidual &residual, const Shot &
   }
   return out;
 }
-
-} // namespace vbrdf
-
-namespace vbrdf {
 
 double ViewpointResidual::rms_radius(const Shot &shot) const {
   double c[2];

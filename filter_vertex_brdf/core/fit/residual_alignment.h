@@ -65,7 +65,6 @@ public:
                     const std::function<void(SampleChunk &)> &prepare, size_t pilot_vertices,
                     double trimmed_share);
   size_t pilot_vertices() const { return pilot_count_; }
-  size_t evaluations() const { return evaluations_; }
   double at(const Shot &shot);
   // RMS distance (pixels) of the pilot vertices' projections from the principal point of `shot`.
   double rms_radius(const Shot &shot) const;
@@ -82,13 +81,11 @@ private:
   PhotoCache &photos_;
   const std::function<void(SampleChunk &)> &prepare_;
   double trimmed_share_;
-  size_t evaluations_ = 0;
 };
 
 struct ResidualShift {
   double dx = 0, dy = 0;                 // image shift from the start camera (pixels)
   double residual_start = 0, residual_end = 0;
-  int rounds = 0;
   bool moved = false;                    // false: the start camera had the lower residual
 };
 

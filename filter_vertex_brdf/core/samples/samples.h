@@ -82,6 +82,12 @@ inline bool is_diffuse_sample(const Sample &s) {
 inline bool is_specular_sample(const Sample &s) {
   return (s.flags & (kShadowed | kSaturated | kMixedPixel)) == 0 && (s.flags & kHighlight) != 0;
 }
+// Usable to score a model's prediction (held-out errors, residuals): lit, unsaturated, clean pixel,
+// d > 0, every value finite.
+inline bool is_scorable_sample(const Sample &s) {
+  return !(s.flags & (kShadowed | kSaturated | kMixedPixel | kNotSeen)) && s.d > 0 && std::isfinite(s.d) &&
+         std::isfinite(s.lobe_cos) && std::isfinite(s.rgb[0]) && std::isfinite(s.rgb[1]) && std::isfinite(s.rgb[2]);
+}
 
 struct GatherSettings {
   float specular_threshold = kDefaultSpecularThreshold;  // T_s on R.E
