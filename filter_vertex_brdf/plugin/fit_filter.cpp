@@ -133,8 +133,9 @@ void FitFilter::initParameters(const MeshDocument &, RichParameterList &params) 
                            "Each viewpoint's camera is measured against its photos (the normals photometric "
                            "stereo reads from them, which the light does not change) and, where it is off by "
                            "more than a quarter pixel, corrected (turn and focal length) before any sample is "
-                           "taken, unless the camera as given explains the photos better (the fitted model's "
-                           "residual); a correction's shift and roll are then refined by that residual. The corrected "
+                           "taken, unless the camera as given explains the photos clearly better (the fitted "
+                           "model's residual); a correction's shift and roll are then refined by that residual "
+                           "by up to 0.12 px. The corrected "
                            "cameras are applied to the project's rasters and written to <output>_registered.mlp; "
                            "the input project is never changed. The report gives each viewpoint's "
                            "misregistration before and after. Off by default."));

@@ -15,9 +15,10 @@ Prints one row per scene x capture x correction: relit CIEDE2000 mean / p95, PTM
 same samples, the misregistration the fit measured (camera captures) or how far the normals moved
 (median degrees), the fit's run time, and how far the input mesh's normals and the result's shading
 normals are from the renderer's own (median / p95 degrees over the vertices the truth sees and the
-fit models). The exact capture runs with both steps on (the product).
+fit models). The exact capture runs with both steps on (the product). The last capture has both
+errors at once (normals smoothed and cameras shifted by 1 px), registration off and on.
 Environment: VBRDF_FIT_OPTIONS, further vbrdf_fit options for every fit (e.g. "--deconvolve off").
---max-ratio: exit 1 unless every perturbed capture with its correction on is within that ratio of
+--max-ratio: exit 1 unless every perturbed capture with one error and its correction on is within that ratio of
 the exact capture's mean and p95 and below PTM and RBF in both, and the refined normals of every
 smoothed mesh closer to the truth than the mesh's in median and p95. Skips (exit 0) without the shared
 scenes.
@@ -33,6 +34,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
+COMBINED = "smoothed, shift 1 px"
 CAPTURES = [  # name, perturb_cameras.py arguments, vbrdf_perturb_mesh arguments, the step that corrects it
     ("exact", [], [], None),
     ("shift 1 px", ["--shift", "0.8", "-0.6"], [], "registration"),
@@ -41,6 +43,10 @@ CAPTURES = [  # name, perturb_cameras.py arguments, vbrdf_perturb_mesh arguments
     ("roll 0.2 deg", ["--rotate", "z", "0.2"], [], "registration"),
     ("normals smoothed", [], ["--smooth-normals", "3", "--target-median", "3.5"], "shading-normals"),
     ("decimated half", [], ["--decimate", "0.5"], "shading-normals"),
+    # A scan as it comes: smoother than the surface and registered a pixel off; shading normals on.
+    # Reported beside the others, not held to --max-ratio (two errors at once: docs/benchmark.md).
+    (COMBINED, ["--shift", "0.8", "-0.6"], ["--smooth-normals", "3", "--target-median", "3.5"],
+     "registration"),
 ]
 STEP_DEFAULTS = {"registration": "off", "shading-normals": "on"}  # the other step, as the product runs
 
@@ -195,7 +201,7 @@ def main():
                       f" {r['rbf_mean']:5.3f} / {r['rbf_p95']:5.3f}  {measured:>14}  {secs:5.1f}  {truth_text}", flush=True)
                 if not step:
                     exact = r
-                elif setting == "on" and args.max_ratio and exact:
+                elif setting == "on" and args.max_ratio and exact and name != COMBINED:
                     for k in ("mean", "p95"):
                         if r[k] > args.max_ratio * exact[k]:
                             failures.append(f"{scene} {name}: {k} {r[k]:.3f} above {args.max_ratio} x exact {exact[k]:.3f}")

@@ -225,6 +225,25 @@ TEST(Registration, RecoversARollOfTheCamera) {
   EXPECT_LT(rms_between(c.mesh, r.rasters[0].shot, c.truth), 0.12);
 }
 
+// A focal change whose effect is below what a smoothed scan's normals read as one (0.35-0.45 px RMS)
+// is not taken for a focal error; with the general effect bound (0.15 px) the same capture would be.
+TEST(Registration, AFocalChangeBelowWhatSmoothingMimicsIsKept) {
+  const SphereCapture c = render_sphere(test::scratch_dir("registration_focal"));
+  ImageWarp zoom;
+  zoom.log_scale = std::log(1.006);
+  const Shot given = warped_shot(c.truth, zoom);
+  const double effect = rms_between(c.mesh, given, c.truth);
+  ASSERT_GT(effect, 0.25);
+  ASSERT_LT(effect, RegistrationSettings().alignment.min_scale_effect_px);
+  const ViewpointRegistration v = refine(c, given).viewpoints.at(0);
+  EXPECT_FALSE(v.scale_determined) << "focal x" << std::exp(v.correction.log_scale);
+  RegistrationSettings loose;
+  loose.alignment.min_scale_effect_px = loose.alignment.min_effect_px;
+  const ViewpointRegistration w = refine(c, given, loose).viewpoints.at(0);
+  EXPECT_TRUE(w.scale_determined);
+  EXPECT_NEAR(w.correction.log_scale, -zoom.log_scale, 0.3 * zoom.log_scale);
+}
+
 // The correction is the same to the bit whatever the thread count: the alignment's sums are added
 // in a fixed order, so a registered result can be compared byte for byte with another run.
 TEST(Registration, CorrectionIsTheSameWhateverTheThreadCount) {
@@ -396,11 +415,32 @@ TEST(ResidualAlignment, RefinementRecoversASmallShift) {
   ASSERT_GT(rms_between(c.mesh, given, c.truth), 0.15);
   ASSERT_LT(rms_between(c.mesh, given, c.truth), RegistrationSettings().threshold_px);
   SphereResidual r(c, given);
-  const ResidualShift shift = refine_shift_by_residual(*r.residual, given, ResidualAlignmentSettings());
+  ResidualAlignmentSettings settings;
+  settings.trusted_shift_px = settings.max_shift_px;  // trusted as far as it searches
+  const ResidualShift shift = refine_shift_by_residual(*r.residual, given, settings);
   EXPECT_TRUE(shift.moved);
+  EXPECT_FALSE(shift.beyond_trust);
   EXPECT_LT(shift.residual_end, shift.residual_start);
   EXPECT_LT(rms_between(c.mesh, shifted_shot(given, shift.dx, shift.dy), c.truth), 0.04)
       << "refined by " << shift.dx << ", " << shift.dy << " px";
+}
+
+// The same 0.18 px with the default trust (0.12 px, the most the normal map's own bias leaves on a
+// mesh with the surface's normals): the minimum is found but not taken, the start camera is kept.
+TEST(ResidualAlignment, MinimumFartherThanTrustedIsNotTaken) {
+  const SphereCapture c = render_sphere(test::scratch_dir("residual_trust"));
+  const Shot given = shifted(c.truth, 0.15f, -0.1f);
+  SphereResidual r(c, given);
+  const ResidualAlignmentSettings settings;
+  ASSERT_LT(settings.trusted_shift_px, 0.18);
+  const ResidualShift shift = refine_shift_by_residual(*r.residual, given, settings);
+  EXPECT_TRUE(shift.beyond_trust);
+  EXPECT_FALSE(shift.moved);
+  EXPECT_EQ(shift.dx, 0.0);
+  EXPECT_EQ(shift.dy, 0.0);
+  EXPECT_EQ(shift.residual_end, shift.residual_start);
+  EXPECT_LT(rms_between(c.mesh, shifted_shot(given, shift.found_dx, shift.found_dy), c.truth), 0.04)
+      << "found at " << shift.found_dx << ", " << shift.found_dy << " px";
 }
 
 // At the true camera the refinement keeps it, or moves it by no more than a few hundredths.

@@ -161,9 +161,12 @@ ResidualShift refine_shift_by_residual(ViewpointResidual &residual, const Shot &
     centre_residual = (nx == grid_x && ny == grid_y) ? grid_best : residual.at(shifted_shot(start, nx, ny));
     cx = nx, cy = ny;
   }
-  if (best < out.residual_start) {
-    out.dx = best_x, out.dy = best_y, out.residual_end = best, out.moved = true;
+  if (!(best < out.residual_start)) return out;
+  if (std::hypot(best_x, best_y) > settings.trusted_shift_px) {
+    out.beyond_trust = true, out.found_dx = best_x, out.found_dy = best_y;
+    return out;
   }
+  out.dx = out.found_dx = best_x, out.dy = out.found_dy = best_y, out.residual_end = best, out.moved = true;
   return out;
 }
 

@@ -27,8 +27,10 @@
 //   `step_px`; its minimum when the quadratic is convex and the minimum lies within 1.5 steps of the
 //   grid's centre, else the best grid point and a new grid about it; at most `max_rounds` grids,
 //   and the shift never beyond `max_shift_px` from the start. The refined shift is kept only when its
-//   residual is below the start's; else the start is kept. Then the roll about the optical axis
-//   (refine_roll_by_residual), which the normal map reads to within a few hundredths of a degree.
+//   residual is below the start's and it lies within `trusted_shift_px` of the start; else the start
+//   is kept (`beyond_trust` says when the residual's minimum lay farther). Then the roll about the
+//   optical axis (refine_roll_by_residual), which the normal map reads to within a few hundredths of
+//   a degree; the caller refines no roll with a residual whose shift was beyond trust.
 // - The masks may come from a camera a few pixels away (the fit makes them at the given camera and
 //   checks the correction against it): the pilot leaves out the rims, where that would matter.
 #include <cstddef>
@@ -51,7 +53,17 @@ struct ResidualAlignmentSettings {
   bool enabled = true;
   size_t pilot_vertices = 4000;  // per viewpoint (docs/decisions/registration.md: fewer read noisier)
   double step_px = 0.1;          // grid spacing: the residual is a clean quadratic over +-0.2 px
-  double max_shift_px = 0.3;     // the refinement's reach from the start camera
+  double max_shift_px = 0.3;     // the refinement's search reach from the start camera
+  // A minimum found farther than this from the start camera is not taken: the normal map's own
+  // bias on meshes with the surface's normals is at most 0.07 px, and a residual made with normals
+  // that are off (a scan smoothed by a few degrees) pulls 0.18-0.42 px away from the true camera
+  // (docs/decisions/registration.md). The residual is then taken to be biased and the start kept.
+  double trusted_shift_px = 0.12;
+  // A correction is refused when its residual exceeds the given camera's by more than this share.
+  // The false readings of synthetic captures (open borders, broad lobes) raise it by 50-600 %; on a
+  // scan smoothed by a few degrees the residual cannot tell the true camera from one a pixel off
+  // (Seitz owl: the true correction 1.6 % above the given camera) and the normal map's reading stands.
+  double refuse_margin = 0.05;
   int max_rounds = 3;
   double trimmed_share = 0.5;    // of the scored samples, the best explained (docs/decisions/registration.md)
 };
@@ -86,7 +98,9 @@ private:
 struct ResidualShift {
   double dx = 0, dy = 0;                 // image shift from the start camera (pixels)
   double residual_start = 0, residual_end = 0;
-  bool moved = false;                    // false: the start camera had the lower residual
+  bool moved = false;                    // false: the start camera had the lower residual, or beyond trust
+  bool beyond_trust = false;             // the residual's minimum lay beyond trusted_shift_px: not taken
+  double found_dx = 0, found_dy = 0;     // where that minimum lay (pixels from the start)
 };
 
 // Minimises the residual over image shifts of `start` (see the contract above).

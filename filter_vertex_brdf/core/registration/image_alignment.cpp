@@ -332,7 +332,7 @@ AlignmentResult align_to_normal_map(const std::vector<AlignmentPoint> &points, c
     out.roll_determined = std::fabs(full.roll) > settings.significance * sigma(2) &&
                           std::fabs(full.roll) * radius >= settings.min_effect_px;
     out.scale_determined = std::fabs(full.log_scale) > settings.significance * sigma(3) &&
-                           std::fabs(full.log_scale) * radius >= settings.min_effect_px;
+                           std::fabs(full.log_scale) * radius >= std::max(settings.min_effect_px, settings.min_scale_effect_px);
     if (out.roll_determined && out.scale_determined) {
       w = full;
     } else if (out.roll_determined || out.scale_determined) {

@@ -47,6 +47,11 @@ struct AlignmentSettings {
   // standard deviations and move the points by at least min_effect_px (RMS); else it stays 0.
   double significance = 3.0;
   double min_effect_px = 0.15;
+  // The focal length (scale) needs more: a mesh whose normals are smoother than the surface's reads
+  // as a scale of 0.995-0.996 on every smoothed scene and relief (0.35-0.45 px RMS over the points;
+  // docs/decisions/registration.md), where a shift or a roll reads nothing false. Below this a focal
+  // error cannot be told from a smoothed scan, and the focal length is kept.
+  double min_scale_effect_px = 0.75;
   bool solve_roll_and_scale = true;
 };
 

@@ -267,14 +267,19 @@ std::string describe_registration(const ViewpointRegistration &v, const Registra
                                 three_significant(v.residual_corrected);
   if (v.refused)
     return s + ", above " + fixed(settings.threshold_px) + " px, but " + residuals +
-           ": the correction does not explain the photos better, camera unchanged";
+           ": the corrected camera explains the photos worse, camera unchanged";
   if (!v.applied) return s + ", below " + fixed(settings.threshold_px) + " px: camera unchanged";
   s += " -> " + fixed(v.after_px) + " px after correction (shift " + fixed(v.shift_x) + ", " + fixed(v.shift_y) +
        " px at the principal point";
   s += v.roll_determined ? ", roll " + fixed(degrees(v.correction.roll), 3) + " deg" : ", roll not determined";
   s += v.scale_determined ? ", focal x" + fixed(std::exp(v.correction.log_scale), 4) : ", focal not determined";
   s += ")";
-  if (v.residual_checked)
+  if (v.residual_checked && v.residual_beyond_trust)
+    s += "; " + residuals + ", least " + fixed(std::hypot(v.residual_found_x, v.residual_found_y)) +
+         " px from the correction, farther than the " + fixed(v.residual_trusted_px) +
+         " px it refines (a residual made with normals that are off, as a smoothed scan's, is biased): "
+         "the normal map's correction kept";
+  else if (v.residual_checked)
     s += "; " + residuals + ", " + three_significant(v.residual_final) + " with the shift refined by " +
          fixed(v.refined_x, 3) + ", " + fixed(v.refined_y, 3) + " px and the roll by " +
          fixed(degrees(v.refined_roll), 3) + " deg";

@@ -29,9 +29,10 @@ struct RegistrationSettings {
   // captures of synthesize_scene, whose cameras are exact, it reads up to 1.3 px (open mesh borders
   // and broad glossy lobes bias the Lambertian normal map: docs/method.md#registration-refined-from-the-photos);
   // the fit checks each correction against the fitted model's residual, which refuses those
-  // (fit/residual_alignment.h, run/fit_run.cpp). But on a mesh smoother than the surface the
-  // residual, made with the mesh's normals, accepts false readings too (two of the five Seitz
-  // reliefs smoothed by 3.5 deg: docs/decisions/registration.md), so it stays the user's choice.
+  // (fit/residual_alignment.h, run/fit_run.cpp). But on a mesh smoother than the surface the map
+  // reads false shifts of 0.4-0.6 px (three of the seven real reliefs smoothed by 3.5 deg) that the
+  // residual, made with the same normals, cannot refuse (docs/decisions/registration.md), so it
+  // stays the user's choice.
   bool enabled = false;
   // A viewpoint whose measured misregistration (RMS displacement of its visible vertices, pixels)
   // is below this keeps its camera: the estimate on exact cameras stays under it
@@ -74,9 +75,13 @@ struct ViewpointRegistration {
   bool residual_checked = false;
   size_t residual_vertices = 0;
   double residual_given = 0, residual_corrected = 0, residual_final = 0;
-  bool refused = false;             // the given camera had the lower residual: camera kept
+  bool refused = false;             // the corrected camera's residual was clearly higher: camera kept
   double refined_x = 0, refined_y = 0;  // the shift the residual added to the correction (pixels)
   double refined_roll = 0;              // and the roll (radians)
+  // The residual's minimum lay farther from the correction than it is trusted to refine (the mesh's
+  // normals are then taken to be off): where, and the trusted distance; nothing refined.
+  bool residual_beyond_trust = false;
+  double residual_found_x = 0, residual_found_y = 0, residual_trusted_px = 0;
 };
 
 struct RegistrationResult {

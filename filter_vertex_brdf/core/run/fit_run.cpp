@@ -482,8 +482,9 @@ ViewpointResidual viewpoint_residual(FitRun &run, const ViewpointRegistration &v
 
 // Each viewpoint the registration corrected, checked by the fitted model's residual
 // (fit/residual_alignment.h) with the masks made at the given cameras: refused (camera kept) where
-// the given camera explains the photos as well. Returns true when a correction was taken: the run
-// then uses the corrected cameras and needs masks made at them.
+// the corrected camera's residual is higher than the given one's by more than refuse_margin.
+// Returns true when a correction was taken: the run then uses the corrected cameras and needs masks
+// made at them.
 bool check_corrections_by_residual(FitRun &run, PhotoCache &photos, const VisibilityMasks &masks,
                                    const std::function<void(SampleChunk &)> &prepare) {
   RegistrationResult &registration = run.result.registration;
@@ -498,7 +499,7 @@ bool check_corrections_by_residual(FitRun &run, PhotoCache &photos, const Visibi
     v.residual_vertices = residual.pilot_vertices();
     v.residual_given = residual.at(v.given);
     v.residual_corrected = v.residual_final = residual.at(v.corrected);
-    if (!(v.residual_corrected < v.residual_given)) {
+    if (!(v.residual_corrected <= v.residual_given * (1 + run.settings.registration_residual.refuse_margin))) {
       v.refused = true, v.applied = false;
       v.corrected = v.given;
       for (size_t r : v.rasters) registration.rasters[r].shot = v.given;
@@ -528,9 +529,16 @@ bool refine_corrections_by_residual(FitRun &run, PhotoCache &photos, const Visib
     ViewpointResidual residual = viewpoint_residual(run, v, photos, masks, prepare);
     const ResidualAlignmentSettings &check = run.settings.registration_residual;
     const ResidualShift shift = refine_shift_by_residual(residual, v.corrected, check);
+    v.residual_corrected = v.residual_final = shift.residual_start;
+    if (shift.beyond_trust) {  // a biased residual refines no roll either
+      v.residual_beyond_trust = true;
+      v.residual_found_x = shift.found_dx, v.residual_found_y = shift.found_dy;
+      v.residual_trusted_px = check.trusted_shift_px;
+      run.log("Registration: " + describe_registration(v, run.settings.registration) + ".");
+      continue;
+    }
     const Shot shifted = shifted_shot(v.corrected, shift.dx, shift.dy);
     const ResidualRoll roll = refine_roll_by_residual(residual, shifted, check, shift.residual_end);
-    v.residual_corrected = shift.residual_start;
     v.residual_final = roll.residual_end;
     if (shift.moved || roll.moved) {
       v.corrected = rolled_shot(shifted, roll.roll);
