@@ -18,9 +18,9 @@ normals are from the renderer's own (median / p95 degrees over the vertices the 
 fit models). The exact capture runs with both steps on (the product). The last capture has both
 errors at once (normals smoothed and cameras shifted by 1 px), registration off and on.
 Environment: VBRDF_FIT_OPTIONS, further vbrdf_fit options for every fit (e.g. "--deconvolve off").
---max-ratio: exit 1 unless every perturbed capture with one error and its correction on is within that ratio of
-the exact capture's mean and p95 and below PTM and RBF in both, and the refined normals of every
-smoothed mesh closer to the truth than the mesh's in median and p95. Skips (exit 0) without the shared
+--max-ratio: exit 1 unless every perturbed capture with one error and its correction on is within
+that ratio of the exact capture's mean and p95 and below PTM and RBF in both, and the refined normals
+of every smoothed mesh closer to the truth than the mesh's in median and p95. Skips (exit 0) without the shared
 scenes.
 """
 import argparse

@@ -60,7 +60,7 @@ struct ResidualAlignmentSettings {
   // (docs/decisions/registration.md). The residual is then taken to be biased and the start kept.
   double trusted_shift_px = 0.12;
   // A correction is refused when its residual exceeds the given camera's by more than this share.
-  // The false readings of synthetic captures (open borders, broad lobes) raise it by 50-600 %; on a
+  // The false readings of synthetic captures (open borders, broad lobes) raise it by 50-610 %; on a
   // scan smoothed by a few degrees the residual cannot tell the true camera from one a pixel off
   // (Seitz owl: the true correction 1.6 % above the given camera) and the normal map's reading stands.
   double refuse_margin = 0.05;
