@@ -2,7 +2,8 @@
 """ctest driver (diffuse_choice_auto): the fit's Auto diffuse form (core/fit/diffuse_choice.h)
 picks the form the photos were made with, and the pick pays off at held-out lights.
 
-    check_diffuse_choice.py --synth synthesize_scene --fit-tool vbrdf_fit --eval-tool vbrdf_eval --workdir DIR
+    check_diffuse_choice.py --synth synthesize_scene --fit-tool vbrdf_fit --eval-tool vbrdf_eval
+                            --perturb-mesh vbrdf_perturb_mesh --perturb-project perturb_cameras.py --workdir DIR
 
 Three synthetic captures of one scene (synthesize_scene, 16-bit linear photos): Lambertian, with
 --coated-diffuse (the diffuse term under a clear coat: Fresnel transmission in and out, the
@@ -13,7 +14,11 @@ two materials). Checks (each can fail):
   * on the coated capture, the Auto fit relights the held-out photos better (vbrdf_eval mean
     CIEDE2000) than a fit forced to Lambert, and its albedo (k_d C) is nearer the truth;
   * on the two-material capture, Auto writes a coat map that agrees with the truth's glossy regions
-    on >= 85 % of the modelled vertices, and relights better than both forms used everywhere.
+    on >= 85 % of the modelled vertices, and relights better than both forms used everywhere;
+  * the same with the mesh's normals smoothed as a scan's are (vbrdf_perturb_mesh, 3.5 deg median):
+    the pilot refines each vertex's normal as the fit does, so the map still agrees on >= 85 %;
+    with the shading normals off (the pilot on the smoothed normals) it must agree less (72 %
+    when measured): the smoothed normals are what the refinement has to undo.
 """
 import argparse
 import os
@@ -38,8 +43,8 @@ def synthesize(args, out, coat_option):
         raise SystemExit(f"FAIL: synthesize_scene exited {rc}:\n{text}")
 
 
-def fit(args, scene, out, form):
-    rc, text = run([args.fit_tool, os.path.join(scene, "project.mlp"), "--out", out, "--diffuse", form])
+def fit(args, scene, out, form, project="project.mlp", options=()):
+    rc, text = run([args.fit_tool, os.path.join(scene, project), "--out", out, "--diffuse", form] + list(options))
     if rc != 0:
         raise SystemExit(f"FAIL: vbrdf_fit exited {rc}:\n{text}")
     return text
@@ -73,6 +78,45 @@ def albedo_error(fit_ply, gt_ply):
     return total / n
 
 
+def coat_map_agreement(fit_ply, scene):
+    """Share of the modelled vertices whose diffuse_form is the truth's (coated where glossy), and
+    how many they are."""
+    fit_v = lib.read_ply(fit_ply).vertex
+    gt = lib.read_ply(os.path.join(scene, "ground_truth", "gt_vertex.ply")).vertex
+    pairs = [(int(f), ks > 0) for f, status, ks in zip(fit_v["diffuse_form"], fit_v["fit_status"], gt["ks"]) if status != 0]
+    return sum(1 for f, glossy in pairs if f == int(glossy)) / max(len(pairs), 1), len(pairs)
+
+
+def check_smoothed_two_materials(args):
+    """The two-material capture with its mesh's normals smoothed: the pilot must see through them."""
+    scene = os.path.join(args.workdir, "two_materials")
+    mesh = os.path.join(scene, "mesh_smoothed.ply")
+    rc, text = run([args.perturb_mesh, os.path.join(scene, "mesh.ply"), mesh, "--smooth-normals", "3",
+                    "--target-median", "3.5"])
+    if rc != 0:
+        raise SystemExit(f"FAIL: vbrdf_perturb_mesh exited {rc}:\n{text}")
+    rc, text = run([sys.executable, args.perturb_project, os.path.join(scene, "project.mlp"),
+                    os.path.join(scene, "project_smoothed.mlp"), "--mesh", mesh])
+    if rc != 0:
+        raise SystemExit(f"FAIL: perturb_cameras.py exited {rc}:\n{text}")
+    agree = {}
+    for normals in ("on", "off"):
+        out = os.path.join(args.workdir, f"two_materials_smoothed_normals_{normals}.ply")
+        fit(args, scene, out, "auto", "project_smoothed.mlp", ["--shading-normals", normals])
+        agree[normals] = coat_map_agreement(out, scene)[0]
+    print(f"two-material capture, normals smoothed: coat map agrees with the glossy regions on "
+          f"{100 * agree['on']:.1f} % (shading normals on), {100 * agree['off']:.1f} % (off: the pilot on the "
+          f"smoothed normals)")
+    failures = []
+    if agree["on"] < 0.85:
+        failures.append(f"smoothed two-material capture: the coat map agrees with the truth on {100 * agree['on']:.1f} % "
+                        "(< 85 %): the pilot did not refine the normals")
+    if not agree["off"] < agree["on"]:
+        failures.append("smoothed two-material capture: the pilot on the smoothed normals agrees as well as with refined "
+                        "ones: the capture does not exercise the refinement")
+    return failures
+
+
 def check_two_materials(args):
     scene = os.path.join(args.workdir, "two_materials")
     synthesize(args, scene, "--coated-glossy")
@@ -81,12 +125,9 @@ def check_two_materials(args):
         out = os.path.join(args.workdir, f"two_materials_{form}.ply")
         log = fit(args, scene, out, form)
         relit[form] = relit_mean(args, scene, out)
-    fit_v = lib.read_ply(os.path.join(args.workdir, "two_materials_auto.ply")).vertex
-    gt = lib.read_ply(os.path.join(scene, "ground_truth", "gt_vertex.ply")).vertex
-    pairs = [(int(f), ks > 0) for f, status, ks in zip(fit_v["diffuse_form"], fit_v["fit_status"], gt["ks"]) if status != 0]
-    agree = sum(1 for f, glossy in pairs if f == int(glossy)) / max(len(pairs), 1)
+    agree, modelled = coat_map_agreement(os.path.join(args.workdir, "two_materials_auto.ply"), scene)
     print(f"two-material capture: coat map agrees with the glossy regions on {100 * agree:.1f} % of "
-          f"{len(pairs)} modelled vertices; relit mean CIEDE2000 Auto {relit['auto']:.3f}, "
+          f"{modelled} modelled vertices; relit mean CIEDE2000 Auto {relit['auto']:.3f}, "
           f"Lambert everywhere {relit['lambert']:.3f}, coated everywhere {relit['coated']:.3f}")
     if agree < 0.85:
         failures.append(f"two-material capture: the coat map agrees with the truth on {100 * agree:.1f} % (< 85 %)")
@@ -97,7 +138,7 @@ def check_two_materials(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    for a in ("--synth", "--fit-tool", "--eval-tool", "--workdir"):
+    for a in ("--synth", "--fit-tool", "--eval-tool", "--perturb-mesh", "--perturb-project", "--workdir"):
         ap.add_argument(a, required=True)
     args = ap.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
@@ -114,6 +155,7 @@ def main():
         if not re.search(r"diffuse term: (lambert|coated) \(Auto: pilot fit of \d+ vertices", log):
             failures.append(f"{name} capture: the report does not say how Auto chose:\n{log}")
     failures += check_two_materials(args)
+    failures += check_smoothed_two_materials(args)
     scene = os.path.join(args.workdir, "coated")
     forced = os.path.join(args.workdir, "coated_lambert.ply")
     fit(args, scene, forced, "lambert")

@@ -12,6 +12,7 @@
 #include "base/vec3.h"
 #include "fit/reflectance_fit.h"
 #include "fit/shading_normals.h"
+#include "inputs/camera.h"
 #include "samples/reshade.h"
 #include "test_scenes.h"
 #include "thesis_settings.h"
@@ -105,6 +106,13 @@ ReflectanceFitOptions fit_options() {
   return o;
 }
 
+// Every vertex of the chunk fitted from its samples (CPU reference).
+std::vector<VertexFit> fit_all(const SampleChunk &chunk) {
+  std::vector<VertexFit> fits(chunk.vertex_count);
+  fit_chunk_cpu(chunk, fit_options(), fits.data());
+  return fits;
+}
+
 // The pipeline's alternation: refine, shade again, fit again (the vertices that moved).
 std::vector<float> refine(const NormalCapture &c, SampleChunk &chunk, std::vector<VertexFit> &fits,
                           const ShadingNormalSettings &settings) {
@@ -157,8 +165,7 @@ TEST(ShadingNormals, RefinementCorrectsPerturbedNormals) {
   NormalCapture c = make_capture();
   perturb(c, 4.0f);
   SampleChunk chunk = gather(c);
-  std::vector<VertexFit> fits(chunk.vertex_count);
-  fit_chunk_cpu(chunk, fit_options(), fits.data());
+  std::vector<VertexFit> fits = fit_all(chunk);
   double kd_error_before = 0, kd_error_after = 0;
   size_t fitted = 0;
   for (const VertexFit &f : fits)
@@ -180,8 +187,7 @@ TEST(ShadingNormals, RefinementCorrectsPerturbedNormals) {
 TEST(ShadingNormals, ExactNormalsStayAndUndeterminedOnesKeepTheMesh) {
   NormalCapture c = make_capture();
   SampleChunk chunk = gather(c);
-  std::vector<VertexFit> fits(chunk.vertex_count);
-  fit_chunk_cpu(chunk, fit_options(), fits.data());
+  std::vector<VertexFit> fits = fit_all(chunk);
   const auto exact = angle_to_truth(c, chunk, refine(c, chunk, fits, ShadingNormalSettings()));
   EXPECT_LT(exact.first, 0.25);  // the fitted lobe is not exactly the truth's: a little play
   EXPECT_LT(exact.second, 1.0);
@@ -189,8 +195,38 @@ TEST(ShadingNormals, ExactNormalsStayAndUndeterminedOnesKeepTheMesh) {
   NormalCapture few = make_capture(3);  // three lights: too few samples for the normal
   perturb(few, 4.0f);
   SampleChunk sparse = gather(few);
-  std::vector<VertexFit> sparse_fits(sparse.vertex_count);
-  fit_chunk_cpu(sparse, fit_options(), sparse_fits.data());
+  std::vector<VertexFit> sparse_fits = fit_all(sparse);
   const std::vector<float> kept = refine(few, sparse, sparse_fits, ShadingNormalSettings());
   EXPECT_EQ(kept, few.mesh.normals);
+}
+
+// One vertex solved on its own (the diffuse form's pilot) is the chunk's solve without the
+// neighbour term: the same normals, and closer to the surface's than the perturbed mesh's.
+TEST(ShadingNormals, OneVertexSolveIsTheChunkSolveWithoutNeighbours) {
+  NormalCapture c = make_capture();
+  perturb(c, 4.0f);
+  SampleChunk chunk = gather(c);
+  std::vector<VertexFit> fits = fit_all(chunk);
+  ShadingNormalSettings settings;
+  settings.neighbour_sweeps = 0;
+  const MeshView mesh = c.mesh.view();
+  std::vector<float> chunk_normals = c.mesh.normals, moved(mesh.vertex_count, -1.0f);
+  std::vector<uint8_t> changed(chunk.vertex_count);
+  refine_shading_normals(chunk, mesh, build_mesh_adjacency(mesh), c.rasters, c.lights, DiffuseForms(), LobeForm::GgxNH,
+                         fits.data(), settings, nullptr, chunk_normals.data(), moved.data(), changed.data());
+  float centre[3];
+  camera_centre(c.rasters[0].shot, centre);
+  std::vector<float> centres;
+  for (size_t r = 0; r < c.rasters.size(); ++r) centres.insert(centres.end(), centre, centre + 3);
+  std::vector<float> one_by_one = c.mesh.normals;
+  size_t moved_count = 0;
+  for (size_t v = 0; v < chunk.vertex_count; ++v) {
+    const uint32_t begin = chunk.offsets[v], end = chunk.offsets[v + 1];
+    moved_count += refine_vertex_normal(chunk.samples.data() + begin, end - begin, &c.mesh.positions[3 * v],
+                                        &c.mesh.normals[3 * v], centres.data(), c.lights, fits[v],
+                                        DiffuseForm::Lambert, LobeForm::GgxNH, settings, &one_by_one[3 * v]);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(one_by_one[3 * v + k], chunk_normals[3 * v + k], 1e-6) << v;
+  }
+  EXPECT_GT(moved_count, 300u);
+  EXPECT_LT(angle_to_truth(c, chunk, one_by_one).first, 0.5 * angle_to_truth(c, chunk, c.mesh.normals).first);
 }

@@ -19,6 +19,11 @@
 //   CPU reference (fit_vertex_cpu), and scored on the usable samples (lit, unsaturated, clean,
 //   d > 0) of the photos with raster % 4 == f: mean absolute RGB error. Folds f = 3, 1, 2, 0 in
 //   turn until at least 8 photos were held out (heldout_folds.h, shared with the material stage).
+// - Shading normals (`normals.enabled`, as the fit refines them: fit/shading_normals.h): each
+//   pilot vertex's normal is refined from its training samples with its fitted model, its samples
+//   shaded again and the vertex fitted again (one round), and the held-out samples (the same ones
+//   under every form) are predicted with that normal. A scan's smoothed normals would otherwise decide the form: the
+//   form that best absorbs a wrong normal is not the one the product's fit needs.
 // - Coat map: a pilot vertex is labelled coated when its 9 nearest other pilot vertices (3-D
 //   distance; itself left out) together predict their held-out photos better coated than
 //   Lambertian; every mesh vertex then takes the label of the nearest pilot vertex over the mesh's
@@ -35,6 +40,7 @@
 
 #include "fit/heldout_folds.h"
 #include "fit/reflectance_fit.h"
+#include "fit/shading_normals.h"
 #include "inputs/light_source.h"
 #include "base/mesh_view.h"
 #include "inputs/photo.h"
@@ -57,6 +63,13 @@ struct DiffuseChoiceOptions {
   double margin = 0.10;      // relative improvement coated everywhere must show over Lambert
                              //   (docs/decisions/diffuse_form.md)
   double map_margin = 0.05;  // relative improvement the coat map must show over the uniform choice
+  ShadingNormalSettings normals = unrefined();  // the fit's shading-normal settings (enabled: refine as it does)
+
+  static ShadingNormalSettings unrefined() {
+    ShadingNormalSettings s;
+    s.enabled = false;
+    return s;
+  }
 };
 
 DiffuseChoice choose_diffuse_forms(const MeshView &mesh, const std::vector<Raster> &rasters,

@@ -167,6 +167,14 @@ bool solve2(const double a[3], const double b[2], double y[2]) {
   return std::isfinite(y[0]) && std::isfinite(y[1]);
 }
 
+// Where unit normal `now` stands in the frame's tangent plane (0 when more than 60 deg away).
+void tangent_offset(const TangentFrame &frame, const float now[3], double x[2]) {
+  const double nd[3] = {now[0], now[1], now[2]};
+  const double along = dot3(nd, frame.n0);
+  x[0] = x[1] = 0;
+  if (along > 0.5) x[0] = dot3(nd, frame.t1) / along, x[1] = dot3(nd, frame.t2) / along;
+}
+
 struct VertexSolution {
   bool determined = false;
   bool fixed = false;  // not solved this round (converged): a neighbour with its current correction
@@ -311,14 +319,8 @@ ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshV
     const VertexFit &fit = fits[i];
     if (fit.status != kFitFull && fit.status != kFitDiffuseOnly) continue;
     modelled[i] = 1;
-    // Where the current normal stands in the mesh normal's tangent plane (a later round starts there).
-    const float *now = normals + 3 * v;
-    const double along = dot3(now, n0);
-    double start[2] = {0, 0};
-    if (along > 0.5) {
-      const double nd[3] = {now[0], now[1], now[2]};
-      start[0] = dot3(nd, frames[i].t1) / along, start[1] = dot3(nd, frames[i].t2) / along;
-    }
+    double start[2];  // a later round starts where the current normal stands
+    tangent_offset(frames[i], normals + 3 * v, start);
     if (active && !active[i]) {  // converged in an earlier round: a fixed neighbour now
       solutions[i].determined = moved_degrees[v] >= 0;
       solutions[i].fixed = true;
@@ -353,6 +355,27 @@ ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshV
     changed[i] = 1;
   }
   return counts;
+}
+
+bool refine_vertex_normal(const Sample *samples, size_t count, const float position[3], const float mesh_normal[3],
+                          const float *centres, const std::vector<LightSource> &lights, const VertexFit &fit,
+                          DiffuseForm form, LobeForm lobe, const ShadingNormalSettings &settings, float normal[3]) {
+  float n0[3] = {mesh_normal[0], mesh_normal[1], mesh_normal[2]};
+  if (!(normalize3(n0) > 0) || (fit.status != kFitFull && fit.status != kFitDiffuseOnly)) return false;
+  const TangentFrame frame = tangent_frame(n0);
+  const std::vector<NormalSample> usable =
+      normal_samples(samples, count, position, centres, lights, settings.use_highlights && fit.ks > 0 && fit.shininess > 0);
+  if (usable.size() < size_t(std::max(settings.min_samples, 3))) return false;
+  double start[2];
+  tangent_offset(frame, normal, start);
+  VertexSolution solution = solve_vertex(VertexProblem{fit, usable, form, lobe, frame}, start, settings);
+  if (!solution.determined) return false;
+  clamp_length(solution.x, std::tan(settings.max_degrees * kDegree));
+  float refined[3];
+  frame.normal_at(solution.x, refined);
+  if (!(dot3(refined, normal) < float(std::cos(settings.converged_degrees * kDegree)))) return false;
+  for (int k = 0; k < 3; ++k) normal[k] = refined[k];
+  return true;
 }
 
 MovedSummary summarise_moved(const std::vector<float> &moved_degrees, const std::vector<uint8_t> &select) {

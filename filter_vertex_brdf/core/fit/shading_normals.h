@@ -73,6 +73,17 @@ ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshV
                                            const ShadingNormalSettings &settings, const uint8_t *active, float *normals,
                                            float *moved_degrees, uint8_t *changed);
 
+// One vertex's shading normal from its own samples alone (no neighbour term): the solve of
+// refine_shading_normals (prior on `mesh_normal`, min_gain, max_degrees) for a caller that fits
+// vertices one by one, such as the diffuse form's pilot (fit/diffuse_choice.h), which must score
+// a model shaded as the product's fit shades it. `normal` (unit) is where the solve starts and,
+// on return, the refined normal; samples at `position` (camera centres 3 per raster). Returns
+// true when it moved by more than converged_degrees; false (normal unchanged) when the fit has no
+// model, there are fewer than min_samples usable samples, or they do not determine the normal.
+bool refine_vertex_normal(const Sample *samples, size_t count, const float position[3], const float mesh_normal[3],
+                          const float *centres, const std::vector<LightSource> &lights, const VertexFit &fit,
+                          DiffuseForm form, LobeForm lobe, const ShadingNormalSettings &settings, float normal[3]);
+
 // Median and 95th percentile of the values >= 0 of `moved_degrees` at the vertices with select[v]
 // != 0 (all when `select` is empty); count = how many there were.
 struct MovedSummary {

@@ -298,8 +298,10 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
                                  (settings.fit_reflectance ? " (as set)" : " (no reflectance fit: the thesis's form)");
   } else {
     const size_t loads_before = photos.loads();
-    const DiffuseChoice choice =
-        choose_diffuse_forms(input.mesh, input.rasters, lights, masks, settings.gather, settings.reflectance, photos, prepare);
+    DiffuseChoiceOptions options;  // the pilot's normals refined as the fit will refine them
+    if (settings.shading_normals.enabled) options.normals = settings.shading_normals;
+    const DiffuseChoice choice = choose_diffuse_forms(input.mesh, input.rasters, lights, masks, settings.gather,
+                                                      settings.reflectance, photos, prepare, options);
     const size_t decoded_again = photos.loads() - loads_before;
     result.diffuse_forms = choice.forms;
     result.diffuse_choice_note = choice.note + (choice.piloted ? ", " + fixed(choice.seconds) + " s" : "") +

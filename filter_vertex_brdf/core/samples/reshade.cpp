@@ -19,6 +19,19 @@ void shade_sample(const float n[3], const float l[3], const float e[3], DiffuseF
   s.flags = flags & 0x3FFu;
 }
 
+void reshade_vertex(Sample *samples, size_t count, const float n[3], const float position[3], const float *centres,
+                    const std::vector<LightSource> &lights, DiffuseForm form, const GatherSettings &settings) {
+  for (size_t k = 0; k < count; ++k) {
+    Sample &s = samples[k];
+    const float *c = centres + 3 * size_t(s.raster);
+    float e[3] = {c[0] - position[0], c[1] - position[1], c[2] - position[2]};
+    normalize3(e);
+    float l[3];
+    light_direction_at(lights[s.raster], position, l);
+    shade_sample(n, l, e, form, settings, s);
+  }
+}
+
 void reshade_chunk(SampleChunk &chunk, const MeshView &mesh, const float *normals, const uint8_t *changed,
                    const std::vector<Raster> &rasters, const std::vector<LightSource> &lights,
                    const GatherSettings &settings, const float *gradients) {
@@ -35,17 +48,13 @@ void reshade_chunk(SampleChunk &chunk, const MeshView &mesh, const float *normal
     float n[3] = {normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
     if (!(normalize3(n) > 0)) continue;
     const float *p = mesh.positions + 3 * v;
-    const DiffuseForm form = settings.diffuse.at(v);
-    for (uint32_t k = chunk.offsets[size_t(i)]; k < chunk.offsets[size_t(i) + 1]; ++k) {
-      Sample &s = chunk.samples[k];
-      const float *c = &centres[3 * s.raster];
-      float e[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-      normalize3(e);
-      float l[3];
-      light_direction_at(lights[s.raster], p, l);
-      shade_sample(n, l, e, form, settings, s);
-      if (footprints && s.footprint > 0) s.footprint = footprint_variance(cameras[s.raster], p, n, gradients + 9 * v);
-    }
+    Sample *samples = chunk.samples.data() + chunk.offsets[size_t(i)];
+    const size_t count = chunk.offsets[size_t(i) + 1] - chunk.offsets[size_t(i)];
+    reshade_vertex(samples, count, n, p, centres.data(), lights, settings.diffuse.at(v), settings);
+    if (footprints)
+      for (size_t k = 0; k < count; ++k)
+        if (samples[k].footprint > 0)
+          samples[k].footprint = footprint_variance(cameras[samples[k].raster], p, n, gradients + 9 * v);
   }
 }
 

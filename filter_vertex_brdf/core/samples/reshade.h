@@ -20,6 +20,11 @@ namespace vbrdf {
 void shade_sample(const float n[3], const float l[3], const float e[3], DiffuseForm form, const GatherSettings &settings,
                   Sample &s);
 
+// The `count` samples of one vertex at `position` shaded again with unit normal `n` (shade_sample;
+// camera centres 3 per raster, lights[raster] at the vertex). Footprints stay as they are.
+void reshade_vertex(Sample *samples, size_t count, const float n[3], const float position[3], const float *centres,
+                    const std::vector<LightSource> &lights, DiffuseForm form, const GatherSettings &settings);
+
 // Every sample of the chunk's vertices with changed[i] != 0 (i = vertex - chunk.first_vertex)
 // shaded again with normals[3 v] (unit; a zero normal leaves the vertex as it is); positions from
 // `mesh`, camera centres from the rasters, lights[raster] at the vertex. `gradients` (9 per mesh
