@@ -35,14 +35,9 @@ std::vector<uint8_t> pilot_mask(const VisibilityMasks &masks, size_t target, siz
   std::vector<uint32_t> seen(masks.vertex_count, 0);
   for (size_t r = 0; r < masks.raster_count; ++r)
     for (size_t v = 0; v < masks.vertex_count; ++v) seen[v] += masks.is_seen(r, v);
-  size_t eligible = 0;
-  for (uint32_t s : seen) eligible += s >= kMinPhotosSeen;
-  const size_t step = std::max<size_t>(1, eligible / std::max<size_t>(1, target));
-  std::vector<uint8_t> mask(masks.vertex_count, 0);
-  count = 0;
-  for (size_t v = 0, k = 0; v < masks.vertex_count; ++v)
-    if (seen[v] >= kMinPhotosSeen && k++ % step == 0) mask[v] = 1, ++count;
-  return mask;
+  std::vector<uint8_t> eligible(masks.vertex_count, 0);
+  for (size_t v = 0; v < seen.size(); ++v) eligible[v] = seen[v] >= kMinPhotosSeen;
+  return every_kth_vertex(eligible, target, count);
 }
 
 // The vertex's fit on `train`, with its shading normal refined as the product's fit refines it

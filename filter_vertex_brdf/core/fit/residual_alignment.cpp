@@ -33,14 +33,9 @@ VisibilityMasks pilot_masks(const VisibilityMasks &masks, const std::vector<size
       seen[v] += masks.is_seen(r, v);
       rim[v] |= uint8_t(masks.is_mixed(r, v));
     }
-  size_t eligible = 0;
-  for (size_t v = 0; v < masks.vertex_count; ++v) eligible += seen[v] >= kMinPhotosSeen && !rim[v];
-  const size_t step = std::max<size_t>(1, eligible / std::max<size_t>(1, target));
-  std::vector<uint8_t> keep(masks.vertex_count, 0);
-  count = 0;
-  for (size_t v = 0, k = 0; v < masks.vertex_count; ++v)
-    if (seen[v] >= kMinPhotosSeen && !rim[v] && k++ % step == 0) keep[v] = 1, ++count;
-  restrict_to_vertices(pilot, keep);
+  std::vector<uint8_t> eligible(masks.vertex_count, 0);
+  for (size_t v = 0; v < masks.vertex_count; ++v) eligible[v] = seen[v] >= kMinPhotosSeen && !rim[v];
+  restrict_to_vertices(pilot, every_kth_vertex(eligible, target, count));
   return pilot;
 }
 

@@ -171,4 +171,15 @@ void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &ve
   }
 }
 
+std::vector<uint8_t> every_kth_vertex(const std::vector<uint8_t> &eligible, size_t target, size_t &count) {
+  size_t eligible_count = 0;
+  for (uint8_t e : eligible) eligible_count += e != 0;
+  const size_t step = std::max<size_t>(1, eligible_count / std::max<size_t>(1, target));
+  std::vector<uint8_t> keep(eligible.size(), 0);
+  count = 0;
+  for (size_t v = 0, k = 0; v < eligible.size(); ++v)
+    if (eligible[v] && k++ % step == 0) keep[v] = 1, ++count;
+  return keep;
+}
+
 } // namespace vbrdf

@@ -51,6 +51,10 @@ VisibilityMasks compute_visibility(const MeshView &mesh, const std::vector<Raste
 // mask keeps every vertex. Throws InputError when the mask's size is not the vertex count.
 void restrict_to_vertices(VisibilityMasks &masks, const std::vector<uint8_t> &vertex_mask);
 
+// A pilot's subsample: every k-th vertex with eligible[v] != 0, in vertex order, k chosen for about
+// `target` of them (all when fewer). Returns the mask for restrict_to_vertices; count = how many.
+std::vector<uint8_t> every_kth_vertex(const std::vector<uint8_t> &eligible, size_t target, size_t &count);
+
 // Photos of one camera (same shot and photo size) see the same vertices at the same image points.
 bool same_view(const Raster &a, const Raster &b);
 
