@@ -45,7 +45,7 @@ std::vector<uint8_t> pilot_mask(const VisibilityMasks &masks, size_t target, siz
 // fit's normals.rounds: the normal solve fits the reflectance at each trial normal, so its first
 // round does nearly all of the work (bunny_two_materials_dir32 smoothed: 0.424 against 0.422
 // relit with three) at a third of the pilot's added time. `normal` (unit) starts at the mesh
-// normal and ends at the one the fit was made with; `train` is shaded with it.
+// normal and ends at the one the fit was made with.
 VertexFit fit_pilot_vertex(std::vector<Sample> &train, const float position[3], const float mesh_normal[3],
                            const float *centres, const std::vector<LightSource> &lights, DiffuseForm form,
                            const GatherSettings &gather, const ReflectanceFitOptions &phong,
@@ -60,10 +60,7 @@ VertexFit fit_pilot_vertex(std::vector<Sample> &train, const float position[3], 
   reshade_vertex(train.data(), train.size(), moved, position, centres, lights, form, gather);
   VertexFit refitted;
   fit_vertex_cpu(train.data(), train.size(), phong, refitted);
-  if (!has_model(refitted)) {  // keep the model and the normal it was fitted with
-    reshade_vertex(train.data(), train.size(), normal, position, centres, lights, form, gather);
-    return fit;
-  }
+  if (!has_model(refitted)) return fit;  // keep the model and the normal it was fitted with
   for (int k = 0; k < 3; ++k) normal[k] = moved[k];
   return refitted;
 }

@@ -22,8 +22,8 @@
 // - Shading normals (`normals.enabled`, as the fit refines them: fit/shading_normals.h): each
 //   pilot vertex's normal is refined from its training samples with its fitted model, its samples
 //   shaded again and the vertex fitted again (one round), and the held-out samples (the same ones
-//   under every form) are predicted with that normal. A scan's smoothed normals would otherwise decide the form: the
-//   form that best absorbs a wrong normal is not the one the product's fit needs.
+//   under every form) are predicted with that normal. A scan's smoothed normals would otherwise
+//   decide the form: the form that best absorbs a wrong normal is not the one the fit needs.
 // - Coat map: a pilot vertex is labelled coated when its 9 nearest other pilot vertices (3-D
 //   distance; itself left out) together predict their held-out photos better coated than
 //   Lambertian; every mesh vertex then takes the label of the nearest pilot vertex over the mesh's

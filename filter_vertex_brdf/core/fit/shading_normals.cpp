@@ -294,6 +294,28 @@ void smooth_corrections(const SampleChunk &chunk, const MeshAdjacency &adjacency
     }
 }
 
+// The vertex's solve from its samples, starting at tangent offset `start`: undetermined when
+// fewer than min_samples of them are usable for the normal (normal_samples).
+VertexSolution solve_from_samples(const Sample *samples, size_t count, const float position[3], const float *centres,
+                                  const std::vector<LightSource> &lights, const VertexFit &fit, DiffuseForm form,
+                                  LobeForm lobe, const TangentFrame &frame, const double start[2],
+                                  const ShadingNormalSettings &settings) {
+  const std::vector<NormalSample> usable =
+      normal_samples(samples, count, position, centres, lights, settings.use_highlights && fit.ks > 0 && fit.shininess > 0);
+  if (usable.size() < size_t(std::max(settings.min_samples, 3))) return VertexSolution();
+  return solve_vertex(VertexProblem{fit, usable, form, lobe, frame}, start, settings);
+}
+
+// Writes the normal at (bounded) tangent offset x into `normal` when it moved from it by more than
+// converged_degrees; false (normal unchanged) when it did not: its samples keep their shading.
+bool take_if_moved(const TangentFrame &frame, const double x[2], const ShadingNormalSettings &settings, float normal[3]) {
+  float refined[3];
+  frame.normal_at(x, refined);
+  if (!(dot3(refined, normal) < float(std::cos(settings.converged_degrees * kDegree)))) return false;
+  for (int k = 0; k < 3; ++k) normal[k] = refined[k];
+  return true;
+}
+
 } // namespace
 
 ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshView &mesh, const MeshAdjacency &adjacency,
@@ -327,16 +349,11 @@ ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshV
       solutions[i].x[0] = start[0], solutions[i].x[1] = start[1];
       continue;
     }
-    const std::vector<NormalSample> samples =
-        normal_samples(chunk.samples.data() + chunk.offsets[i], chunk.offsets[i + 1] - chunk.offsets[i],
-                       mesh.positions + 3 * v, centres.data(), lights,
-                       settings.use_highlights && fit.ks > 0 && fit.shininess > 0);
-    if (samples.size() < size_t(std::max(settings.min_samples, 3))) continue;
-    const VertexProblem problem{fit, samples, forms.at(v), lobe, frames[i]};
-    solutions[i] = solve_vertex(problem, start, settings);
+    solutions[i] = solve_from_samples(chunk.samples.data() + chunk.offsets[i], chunk.offsets[i + 1] - chunk.offsets[i],
+                                      mesh.positions + 3 * v, centres.data(), lights, fit, forms.at(v), lobe, frames[i],
+                                      start, settings);
   }
   smooth_corrections(chunk, adjacency, frames, solutions, settings);
-  const float still = float(std::cos(settings.converged_degrees * kDegree));
   for (size_t i = 0; i < n; ++i) {
     const size_t v = chunk.first_vertex + i;
     if (!modelled[i] || solutions[i].fixed) continue;
@@ -348,11 +365,7 @@ ShadingNormalCounts refine_shading_normals(const SampleChunk &chunk, const MeshV
     ++counts.refined;
     clamp_length(solutions[i].x, max_length);
     moved_degrees[v] = float(std::atan(std::hypot(solutions[i].x[0], solutions[i].x[1])) / kDegree);
-    float refined[3];
-    frames[i].normal_at(solutions[i].x, refined);
-    if (!(dot3(refined, normals + 3 * v) < still)) continue;  // converged: its samples keep their shading
-    for (int k = 0; k < 3; ++k) normals[3 * v + size_t(k)] = refined[k];
-    changed[i] = 1;
+    changed[i] = uint8_t(take_if_moved(frames[i], solutions[i].x, settings, normals + 3 * v));
   }
   return counts;
 }
@@ -363,19 +376,13 @@ bool refine_vertex_normal(const Sample *samples, size_t count, const float posit
   float n0[3] = {mesh_normal[0], mesh_normal[1], mesh_normal[2]};
   if (!(normalize3(n0) > 0) || (fit.status != kFitFull && fit.status != kFitDiffuseOnly)) return false;
   const TangentFrame frame = tangent_frame(n0);
-  const std::vector<NormalSample> usable =
-      normal_samples(samples, count, position, centres, lights, settings.use_highlights && fit.ks > 0 && fit.shininess > 0);
-  if (usable.size() < size_t(std::max(settings.min_samples, 3))) return false;
   double start[2];
   tangent_offset(frame, normal, start);
-  VertexSolution solution = solve_vertex(VertexProblem{fit, usable, form, lobe, frame}, start, settings);
+  VertexSolution solution =
+      solve_from_samples(samples, count, position, centres, lights, fit, form, lobe, frame, start, settings);
   if (!solution.determined) return false;
   clamp_length(solution.x, std::tan(settings.max_degrees * kDegree));
-  float refined[3];
-  frame.normal_at(solution.x, refined);
-  if (!(dot3(refined, normal) < float(std::cos(settings.converged_degrees * kDegree)))) return false;
-  for (int k = 0; k < 3; ++k) normal[k] = refined[k];
-  return true;
+  return take_if_moved(frame, solution.x, settings, normal);
 }
 
 MovedSummary summarise_moved(const std::vector<float> &moved_degrees, const std::vector<uint8_t> &select) {

@@ -298,8 +298,8 @@ void decide_diffuse_form(const FitInput &input, const std::vector<LightSource> &
                                  (settings.fit_reflectance ? " (as set)" : " (no reflectance fit: the thesis's form)");
   } else {
     const size_t loads_before = photos.loads();
-    DiffuseChoiceOptions options;  // the pilot's normals refined as the fit will refine them
-    if (settings.shading_normals.enabled) options.normals = settings.shading_normals;
+    DiffuseChoiceOptions options;
+    options.normals = settings.shading_normals;  // the pilot's normals refined as the fit will refine them
     const DiffuseChoice choice = choose_diffuse_forms(input.mesh, input.rasters, lights, masks, settings.gather,
                                                       settings.reflectance, photos, prepare, options);
     const size_t decoded_again = photos.loads() - loads_before;
